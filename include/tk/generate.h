@@ -1,0 +1,34 @@
+/* tightknot: example knots and links, made by the project's own code.
+ *
+ * All generators produce closed, embedded polygons with vertices evenly
+ * spaced in parameter; `vertices` is the count per component (0 = the
+ * generator's default).  These are the examples the project ships.
+ */
+#ifndef TK_GENERATE_H
+#define TK_GENERATE_H
+
+#include <stddef.h>
+
+#include "tk/curve.h"
+#include "tk/error.h"
+
+/* Torus knot or link T(p, q) on the standard torus (major radius 2, minor
+ * radius 1): gcd(p, q) components, p, q >= 1. */
+int tk_generate_torus(int p, int q, size_t vertices, tk_curve **out,
+                      tk_error *err);
+
+/* Hopf link: two round circles of radius 1, in perpendicular planes, each
+ * passing through the other's centre (the tight Hopf link when the tube
+ * diameter is 1).  Each circle has a vertex at the other's centre. */
+int tk_generate_hopf(size_t vertices, tk_curve **out, tk_error *err);
+
+/* Borromean rings: three mutually perpendicular ellipses with semi-axes 2
+ * and 1. */
+int tk_generate_borromean(size_t vertices, tk_curve **out, tk_error *err);
+
+/* A chain of k >= 1 round rings of radius 1, centres 1.5 apart along the x
+ * axis, in alternating planes, each linked with its neighbours only. */
+int tk_generate_chain(size_t k, size_t vertices, tk_curve **out,
+                      tk_error *err);
+
+#endif

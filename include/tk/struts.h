@@ -1,0 +1,108 @@
+/* tightknot: finding struts (self-contacts) with a bounding-volume tree.
+ *
+ * A strut is a pair of edges (e_i, e_j) at (near) minimal distance whose
+ * closest points form a local minimum of the self-distance function (a
+ * doubly critical pair, Definition 1): where a closest point falls on a
+ * vertex, the pair counts only if that vertex is also a minimum across the
+ * vertex's other edge, and the contact is reported once, by the edge that
+ * starts at that vertex.
+ *
+ * Edge pairs are filtered by the arc between them (Theorem 3): walking
+ * along the shorter arc (each arc, for closed components) the vertices
+ * strictly between the two edges must be able to turn by at least pi in
+ * total.  Two weightings of "able to turn" are used:
+ *   - TK_ARC_ADMISSIBLE: vertex k turns at most 2 atan(l_k / tau), l_k the
+ *     shorter of its edges, tau the target diameter (Theorem 3, generalised
+ *     to unequal edges).  This is the flow's constraint set.
+ *   - TK_ARC_FENCHEL: vertex k turns by its actual turning angle.  A doubly
+ *     critical pair always has at least pi of turning on each arc (Fenchel's
+ *     theorem), so this filter loses no doubly critical pair; used to
+ *     measure thickness of arbitrary input.
+ * Pairs on different components are always admissible.
+ *
+ * The tree is built over edges in curve order (each node an arc), which
+ * makes refitting after a step O(V) and lets whole node pairs be skipped by
+ * the arc filter.  A finder owns its tree and workspace: one per thread.
+ */
+#ifndef TK_STRUTS_H
+#define TK_STRUTS_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "tk/curve.h"
+#include "tk/error.h"
+
+typedef struct tk_strut {
+    size_t comp[2];  /* components of the two edges */
+    size_t edge[2];  /* edge indices within their components */
+    double s, t;     /* parameters along the two edges, in [0, 1] */
+    double p[3];     /* closest point on the first edge */
+    double q[3];     /* closest point on the second edge */
+    double length;   /* |p - q| */
+    double force;    /* compression from the flow's NNLS (0 when unknown) */
+} tk_strut;
+
+typedef struct tk_kink {
+    size_t comp;     /* component */
+    size_t vertex;   /* vertex index within its component */
+    double minrad;   /* polygonal radius of curvature there (equation 3) */
+    double force;    /* compression from the flow's NNLS (0 when unknown) */
+} tk_kink;
+
+/* A growable list; free with tk_strut_list_free. */
+typedef struct tk_strut_list {
+    tk_strut *items;
+    size_t count;
+    size_t capacity;
+} tk_strut_list;
+
+void tk_strut_list_clear(tk_strut_list *list);
+void tk_strut_list_free(tk_strut_list *list);
+
+typedef enum tk_arc_rule {
+    TK_ARC_ADMISSIBLE = 0,
+    TK_ARC_FENCHEL = 1
+} tk_arc_rule;
+
+typedef struct tk_strut_finder tk_strut_finder;
+
+/* Builds a finder (and its tree) for curve c.  The finder keeps no pointer
+ * to c: every call passes the curve, which must keep its vertex counts. */
+int tk_strut_finder_new(const tk_curve *c, tk_strut_finder **out,
+                        tk_error *err);
+void tk_strut_finder_free(tk_strut_finder **p);
+
+/* Refits the tree's boxes after the vertices moved (same counts).  O(V). */
+void tk_strut_finder_refit(tk_strut_finder *f, const tk_curve *c);
+
+/* Appends to out every strut whose length is <= bound, among edge pairs
+ * passing the arc rule (tau is the diameter used by TK_ARC_ADMISSIBLE; it
+ * is ignored by TK_ARC_FENCHEL).  Sorted by (comp, edge) pairs. */
+int tk_strut_finder_find(tk_strut_finder *f, const tk_curve *c,
+                         tk_arc_rule rule, double tau, double bound,
+                         tk_strut_list *out, tk_error *err);
+
+/* The shortest doubly critical self-distance of the curve (Definition 1),
+ * by branch and bound on the tree; +INFINITY when there is none (e.g. a
+ * single open edge).  If where is non-NULL it receives that strut. */
+int tk_strut_finder_shortest(tk_strut_finder *f, const tk_curve *c,
+                             double *shortest, tk_strut *where,
+                             tk_error *err);
+
+/* The same answers by checking every pair of edges: O(V^2), for tests and
+ * for comparison in benchmarks. */
+int tk_struts_find_brute(const tk_curve *c, tk_arc_rule rule, double tau,
+                         double bound, tk_strut_list *out, tk_error *err);
+double tk_struts_shortest_brute(const tk_curve *c, tk_strut *where);
+
+/* Whether the global edges i and j pass the arc rule (exposed for tests). */
+bool tk_struts_pair_allowed(const tk_curve *c, tk_arc_rule rule, double tau,
+                            size_t i, size_t j);
+
+/* Every vertex whose 2 * minrad is <= bound (kinks), appended to *out
+ * (a malloc'd array the caller frees), *count set. */
+int tk_kinks_find(const tk_curve *c, double bound, tk_kink **out,
+                  size_t *count, tk_error *err);
+
+#endif

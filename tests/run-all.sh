@@ -1,0 +1,66 @@
+#!/bin/sh
+# Runs every test and closes with one line: "tests: N passed, M failed".
+#   run-all.sh [--unit-only] BUILD_DIR SANITIZER_BUILD_DIR CATALOGUE_DIR
+# Unit tests (Check, one process per test) run from both build directories;
+# the command-line tests (tests/cli-*.sh) run against BUILD_DIR's programs.
+set -u
+unit_only=0
+if [ "${1:-}" = "--unit-only" ]; then unit_only=1; shift; fi
+build=$1
+asan=${2:-}
+TK_CATALOGUE=$3
+export TK_CATALOGUE
+if [ ! -d "$TK_CATALOGUE" ]; then
+    echo "note: catalogue $TK_CATALOGUE is absent; tests that need it are skipped"
+fi
+
+passed=0
+failed=0
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+
+# Check's summary line: "100%: Checks: 7, Failures: 0, Errors: 0"
+count_check() {
+    line=$(grep -E '^[0-9]+%: Checks: ' "$log" | tail -n 1)
+    if [ -z "$line" ]; then
+        failed=$((failed + 1))
+        echo "FAIL $1: no summary (crashed?)"
+        tail -n 20 "$log"
+        return
+    fi
+    checks=$(echo "$line" | sed -E 's/.*Checks: ([0-9]+).*/\1/')
+    bad=$(echo "$line" | sed -E 's/.*Failures: ([0-9]+), Errors: ([0-9]+).*/\1 \2/' | awk '{print $1 + $2}')
+    passed=$((passed + checks - bad))
+    failed=$((failed + bad))
+    echo "$1: $line"
+    [ "$bad" -eq 0 ] || grep -E ':[EF]:' "$log"
+}
+
+for dir in "$build" $asan; do
+    [ -d "$dir/tests" ] || continue
+    for t in "$dir"/tests/test_*; do
+        case "$t" in *.o|*.d) continue ;; esac
+        [ -x "$t" ] || continue
+        "$t" >"$log" 2>&1
+        count_check "$t"
+    done
+done
+
+if [ "$unit_only" -eq 0 ]; then
+    for t in tests/cli-*.sh; do
+        [ -f "$t" ] || continue
+        TK_BUILD=$build sh "$t" >"$log" 2>&1
+        line=$(grep -E '^[a-z-]+: [0-9]+ passed, [0-9]+ failed' "$log" | tail -n 1)
+        if [ -z "$line" ]; then
+            failed=$((failed + 1)); echo "FAIL $t: no summary"; tail -n 20 "$log"; continue
+        fi
+        p=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\1/')
+        f=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\2/')
+        passed=$((passed + p)); failed=$((failed + f))
+        echo "$t: $line"
+        [ "$f" -eq 0 ] || grep -E '^FAIL' "$log"
+    done
+fi
+
+echo "tests: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
