@@ -34,6 +34,7 @@ int tk_curve_new(tk_curve **out, size_t ncomp, const size_t *counts,
         c->offset[i + 1] = c->offset[i] + counts[i];
         c->closed[i] = closed[i];
     }
+    *out = c;
     return TK_OK;
 }
 

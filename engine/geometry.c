@@ -1,0 +1,308 @@
+#include "tk/geometry.h"
+
+#include <math.h>
+#include <string.h>
+
+static inline double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static inline void sub3(const double *a, const double *b, double *out)
+{
+    out[0] = a[0] - b[0];
+    out[1] = a[1] - b[1];
+    out[2] = a[2] - b[2];
+}
+
+static inline void cross3(const double *a, const double *b, double *out)
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static inline double clamp01(double x)
+{
+    return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);
+}
+
+static inline void point_at(const double *a0, const double *d, double s, double *out)
+{
+    out[0] = a0[0] + s * d[0];
+    out[1] = a0[1] + s * d[1];
+    out[2] = a0[2] + s * d[2];
+}
+
+static inline double dist3(const double *a, const double *b)
+{
+    double d[3];
+    sub3(a, b, d);
+    return sqrt(dot3(d, d));
+}
+
+/* Parameter of the point of segment (a0, d) closest to x. */
+static double project(const double *x, const double *a0, const double *d, double dd)
+{
+    if (dd <= 0.0)
+        return 0.0;
+    double r[3];
+    sub3(x, a0, r);
+    return clamp01(dot3(r, d) / dd);
+}
+
+static bool snap(double *s)
+{
+    if (*s < TK_SNAP_PARAMETER) {
+        *s = 0.0;
+        return true;
+    }
+    if (*s > 1.0 - TK_SNAP_PARAMETER) {
+        *s = 1.0;
+        return true;
+    }
+    return false;
+}
+
+/* The squared distance on the square [0,1]^2 is convex, so its minimum is
+ * either the interior critical point (when the segments are not parallel
+ * and it lies inside) or on the square's boundary, which consists of the
+ * four point-to-segment problems.  Taking the best of these candidates is
+ * robust for parallel and nearly parallel segments, where solving the 2x2
+ * system alone loses accuracy. */
+void tk_segment_closest(const double a0[3], const double a1[3],
+                        const double b0[3], const double b1[3],
+                        tk_closest *out)
+{
+    double d1[3], d2[3], r[3];
+    sub3(a1, a0, d1);
+    sub3(b1, b0, d2);
+    sub3(a0, b0, r);
+    double a = dot3(d1, d1), e = dot3(d2, d2), b = dot3(d1, d2);
+    double c = dot3(d1, r), f = dot3(d2, r);
+
+    double best_s = 0.0, best_t = project(a0, b0, d2, e);
+    double p[3], q[3];
+    point_at(b0, d2, best_t, q);
+    double best = dist3(a0, q);
+
+    double cand_s[3] = {1.0, 0.0, 0.0}, cand_t[3] = {0.0, 0.0, 1.0};
+    cand_t[0] = project(a1, b0, d2, e);
+    cand_s[1] = project(b0, a0, d1, a);
+    cand_s[2] = project(b1, a0, d1, a);
+    for (int k = 0; k < 3; k++) {
+        point_at(a0, d1, cand_s[k], p);
+        point_at(b0, d2, cand_t[k], q);
+        double dk = dist3(p, q);
+        if (dk < best) {
+            best = dk;
+            best_s = cand_s[k];
+            best_t = cand_t[k];
+        }
+    }
+
+    double denom = a * e - b * b;
+    if (a > 0.0 && e > 0.0 && denom > 1e-14 * a * e) {
+        double s = (b * f - c * e) / denom;
+        double t = (a * f - b * c) / denom;
+        if (s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0) {
+            point_at(a0, d1, s, p);
+            point_at(b0, d2, t, q);
+            double dk = dist3(p, q);
+            if (dk <= best) {
+                best = dk;
+                best_s = s;
+                best_t = t;
+            }
+        }
+    }
+
+    /* Snap parameters next to an end point onto it, then let the other
+     * parameter follow, so that a contact at a shared vertex is seen the
+     * same (bit for bit) from both edges at that vertex. */
+    bool snapped_s = snap(&best_s), snapped_t = snap(&best_t);
+    if (snapped_s && !snapped_t) {
+        point_at(a0, d1, best_s, p);
+        best_t = project(p, b0, d2, e);
+        snap(&best_t);
+    } else if (snapped_t && !snapped_s) {
+        point_at(b0, d2, best_t, q);
+        best_s = project(q, a0, d1, a);
+        snap(&best_s);
+    }
+    /* End points are taken exactly, not recomputed as a0 + 1 * d. */
+    if (best_s == 0.0)
+        memcpy(out->p, a0, sizeof out->p);
+    else if (best_s == 1.0)
+        memcpy(out->p, a1, sizeof out->p);
+    else
+        point_at(a0, d1, best_s, out->p);
+    if (best_t == 0.0)
+        memcpy(out->q, b0, sizeof out->q);
+    else if (best_t == 1.0)
+        memcpy(out->q, b1, sizeof out->q);
+    else
+        point_at(b0, d2, best_t, out->q);
+    out->s = best_s;
+    out->t = best_t;
+    out->dist = dist3(out->p, out->q);
+}
+
+/* Equation (7): by Clarke's theorem for min-functions, the derivative of
+ * the distance is that of |p(s0) - q(t0)| at the fixed minimising
+ * parameters. */
+void tk_segment_distance_gradient(const tk_closest *c, double grad[12])
+{
+    double u[3];
+    sub3(c->p, c->q, u);
+    double n = sqrt(dot3(u, u));
+    if (!(n > 0.0)) {
+        memset(grad, 0, 12 * sizeof *grad);
+        return;
+    }
+    for (int k = 0; k < 3; k++) {
+        u[k] /= n;
+        grad[k] = (1.0 - c->s) * u[k];
+        grad[3 + k] = c->s * u[k];
+        grad[6 + k] = -(1.0 - c->t) * u[k];
+        grad[9 + k] = -c->t * u[k];
+    }
+}
+
+double tk_vertex_turning(const double prev[3], const double v[3],
+                         const double next[3])
+{
+    double a[3], b[3], x[3];
+    sub3(v, prev, a);
+    sub3(next, v, b);
+    cross3(a, b, x);
+    return atan2(sqrt(dot3(x, x)), dot3(a, b));
+}
+
+/* Equation (3) written without angles: with a, b the incoming and outgoing
+ * edge vectors, tan(theta/2) = |a x b| / (|a||b| + a.b), so
+ *     minrad = min(|a|, |b|) * (|a||b| + a.b) / (2 |a x b|),
+ * which stays accurate for small and for nearly reversing turns. */
+double tk_vertex_minrad(const double prev[3], const double v[3],
+                        const double next[3])
+{
+    double a[3], b[3], x[3];
+    sub3(v, prev, a);
+    sub3(next, v, b);
+    cross3(a, b, x);
+    double la = sqrt(dot3(a, a)), lb = sqrt(dot3(b, b));
+    double sin_term = sqrt(dot3(x, x));
+    if (!(sin_term > 0.0))
+        return dot3(a, b) >= 0.0 ? INFINITY : 0.0;
+    return fmin(la, lb) * (la * lb + dot3(a, b)) / (2.0 * sin_term);
+}
+
+/* The gradient of equation (3), the quantity whose gradient the paper
+ * writes as (6): differentiate h = (|a||b| + a.b) / |a x b| = cot(theta/2)
+ * with respect to the edge vectors a and b by the quotient rule, then
+ * minrad = L h / 2 with L the shorter edge's length, and map edge vectors
+ * back to vertices (a = v - prev, b = next - v). */
+double tk_vertex_minrad_gradient(const double prev[3], const double v[3],
+                                 const double next[3], double grad[9])
+{
+    double a[3], b[3], x[3];
+    sub3(v, prev, a);
+    sub3(next, v, b);
+    cross3(a, b, x);
+    double la = sqrt(dot3(a, a)), lb = sqrt(dot3(b, b));
+    double ab = dot3(a, b);
+    double den = sqrt(dot3(x, x));
+    memset(grad, 0, 9 * sizeof *grad);
+    if (!(den > 0.0))
+        return ab >= 0.0 ? INFINITY : 0.0;
+    double num = la * lb + ab;
+    double h = num / den;
+    bool a_shorter = la <= lb;
+    double len = a_shorter ? la : lb;
+
+    double ga[3], gb[3];
+    for (int k = 0; k < 3; k++) {
+        double dnum_a = a[k] / la * lb + b[k];
+        double dnum_b = b[k] / lb * la + a[k];
+        double dden_a = (a[k] * lb * lb - ab * b[k]) / den;
+        double dden_b = (b[k] * la * la - ab * a[k]) / den;
+        double dh_a = (dnum_a * den - num * dden_a) / (den * den);
+        double dh_b = (dnum_b * den - num * dden_b) / (den * den);
+        ga[k] = 0.5 * len * dh_a + (a_shorter ? 0.5 * h * a[k] / la : 0.0);
+        gb[k] = 0.5 * len * dh_b + (a_shorter ? 0.0 : 0.5 * h * b[k] / lb);
+    }
+    for (int k = 0; k < 3; k++) {
+        grad[k] = -ga[k];
+        grad[3 + k] = ga[k] - gb[k];
+        grad[6 + k] = gb[k];
+    }
+    return 0.5 * len * h;
+}
+
+int tk_curve_vertex_neighbours(const tk_curve *c, size_t v, size_t *prev,
+                               size_t *next)
+{
+    size_t lo = 0, hi = c->ncomp;
+    while (hi - lo > 1) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (c->offset[mid] <= v)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    size_t n = tk_curve_comp_vertices(c, lo);
+    size_t k = v - c->offset[lo];
+    if (!c->closed[lo] && (k == 0 || k + 1 >= n))
+        return 0;
+    if (prev)
+        *prev = c->offset[lo] + (k + n - 1) % n;
+    if (next)
+        *next = c->offset[lo] + (k + 1) % n;
+    return 1;
+}
+
+double tk_curve_minrad(const tk_curve *c, size_t *where)
+{
+    double best = INFINITY;
+    size_t best_v = (size_t)-1;
+    for (size_t comp = 0; comp < c->ncomp; comp++) {
+        size_t n = tk_curve_comp_vertices(c, comp), base = c->offset[comp];
+        size_t first = c->closed[comp] ? 0 : 1;
+        size_t last = c->closed[comp] ? n : (n >= 1 ? n - 1 : 0);
+        for (size_t k = first; k < last; k++) {
+            size_t pv = base + (k + n - 1) % n, nv = base + (k + 1) % n;
+            double r = tk_vertex_minrad(c->xyz + 3 * pv, c->xyz + 3 * (base + k),
+                                        c->xyz + 3 * nv);
+            if (r < best) {
+                best = r;
+                best_v = base + k;
+            }
+        }
+    }
+    if (where)
+        *where = best_v;
+    return best;
+}
+
+/* Equation (14): each edge pulls its two end points towards each other
+ * with unit force. */
+void tk_curve_length_gradient(const tk_curve *c, double *grad)
+{
+    memset(grad, 0, 3 * c->nvert * sizeof *grad);
+    for (size_t comp = 0; comp < c->ncomp; comp++) {
+        size_t ne = tk_curve_comp_edges(c, comp);
+        for (size_t k = 0; k < ne; k++) {
+            size_t h = tk_curve_vertex_index(c, comp, k);
+            size_t t = tk_curve_vertex_index(c, comp, k + 1);
+            double u[3];
+            sub3(c->xyz + 3 * t, c->xyz + 3 * h, u);
+            double n = sqrt(dot3(u, u));
+            if (!(n > 0.0))
+                continue;
+            for (int j = 0; j < 3; j++) {
+                grad[3 * h + j] -= u[j] / n;
+                grad[3 * t + j] += u[j] / n;
+            }
+        }
+    }
+}

@@ -1,0 +1,637 @@
+/* Strut search.
+ *
+ * The tree: a binary bounding-box hierarchy over the edges in curve order.
+ * Each node covers a contiguous range of global edge indices, never
+ * straddling a component boundary below the nodes that split components
+ * apart, so that a node is an arc of one component.  Building is O(E log E)
+ * only in the box fitting (the split is the midpoint of the range), refit is
+ * O(E).  Node pairs are pruned by box distance and by the arc rule.
+ *
+ * One contact, one strut: the closest points (p, q) of an edge pair may sit
+ * on a vertex shared with a neighbouring edge.  The pair then stands for a
+ * contact only if (p, q) is also the minimum over every other edge pair that
+ * contains p and q (squared distance is convex on each pair of edges, so
+ * that is the same as a local minimum of the self-distance: Definition 1's
+ * doubly critical test), and the contact is reported by one owner pair:
+ * the edge that starts at the vertex, when that pair passes the arc rule.
+ */
+#include "tk/struts.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tk/geometry.h"
+
+#define LEAF_EDGES 4
+#define NO_EDGE SIZE_MAX
+#define NO_COMP SIZE_MAX
+/* Arcs must turn by at least pi; the margin keeps arcs that turn by exactly
+ * pi (antipodal edges of a regular polygon) despite rounding in the sums. */
+#define ARC_TURN_NEEDED (M_PI * (1.0 - 1e-9))
+/* Distances of the same contact seen from two edge pairs agree to rounding. */
+#define SAME_CONTACT_REL 1e-12
+
+typedef struct tree_node {
+    double lo[3], hi[3];
+    size_t first, end;  /* global edge range [first, end) */
+    size_t left, right; /* children, 0 for a leaf (the root is node 0) */
+    size_t comp;        /* the component when the range lies in one */
+} tree_node;
+
+struct tk_strut_finder {
+    size_t nedges;
+    size_t nvert;
+    size_t ncomp;
+    size_t *head, *tail;      /* per edge: global vertex indices */
+    size_t *comp;             /* per edge */
+    size_t *local;            /* per edge: index within its component */
+    size_t *prev, *next;      /* per edge: neighbouring edges or NO_EDGE */
+    size_t *comp_first_edge;  /* ncomp + 1 */
+    bool *comp_closed;
+    double *prefix;           /* per component n+1 sums of vertex weights */
+    size_t *prefix_offset;    /* ncomp: start of each component's sums */
+    tree_node *nodes;
+    size_t nnodes;
+};
+
+/* The state of one query. */
+typedef struct query {
+    tk_strut_finder *f;
+    const tk_curve *c;
+    tk_arc_rule rule;
+    double bound;             /* report contacts of length <= bound */
+    bool shortest_mode;       /* bound shrinks to the best contact found */
+    tk_strut best;
+    tk_strut_list *out;
+    int status;
+} query;
+
+void tk_strut_list_clear(tk_strut_list *list)
+{
+    list->count = 0;
+}
+
+void tk_strut_list_free(tk_strut_list *list)
+{
+    free(list->items);
+    list->items = NULL;
+    list->count = list->capacity = 0;
+}
+
+static int list_push(tk_strut_list *list, const tk_strut *s)
+{
+    if (list->count == list->capacity) {
+        size_t cap = list->capacity ? 2 * list->capacity : 64;
+        tk_strut *grown = realloc(list->items, cap * sizeof *grown);
+        if (!grown)
+            return TK_ENOMEM;
+        list->items = grown;
+        list->capacity = cap;
+    }
+    list->items[list->count++] = *s;
+    return TK_OK;
+}
+
+void tk_strut_finder_free(tk_strut_finder **p)
+{
+    if (!p || !*p)
+        return;
+    tk_strut_finder *f = *p;
+    free(f->head);
+    free(f->tail);
+    free(f->comp);
+    free(f->local);
+    free(f->prev);
+    free(f->next);
+    free(f->comp_first_edge);
+    free(f->comp_closed);
+    free(f->prefix);
+    free(f->prefix_offset);
+    free(f->nodes);
+    free(f);
+    *p = NULL;
+}
+
+static size_t build_node(tk_strut_finder *f, size_t first, size_t end)
+{
+    size_t id = f->nnodes++;
+    tree_node *n = &f->nodes[id];
+    n->first = first;
+    n->end = end;
+    n->left = n->right = 0;
+    n->comp = f->comp[first] == f->comp[end - 1] ? f->comp[first] : NO_COMP;
+    if (end - first <= LEAF_EDGES && n->comp != NO_COMP)
+        return id;
+    size_t split = first + (end - first) / 2;
+    if (n->comp == NO_COMP) {
+        /* Split at the component boundary nearest the middle. */
+        size_t best = NO_EDGE, best_gap = SIZE_MAX;
+        for (size_t c = f->comp[first] + 1; c <= f->comp[end - 1]; c++) {
+            size_t b = f->comp_first_edge[c];
+            size_t gap = b > split ? b - split : split - b;
+            if (b > first && b < end && gap < best_gap) {
+                best = b;
+                best_gap = gap;
+            }
+        }
+        split = best;
+    }
+    size_t left = build_node(f, first, split);
+    size_t right = build_node(f, split, end);
+    f->nodes[id].left = left;
+    f->nodes[id].right = right;
+    return id;
+}
+
+int tk_strut_finder_new(const tk_curve *c, tk_strut_finder **out, tk_error *err)
+{
+    *out = NULL;
+    tk_strut_finder *f = calloc(1, sizeof *f);
+    if (!f)
+        return tk_error_set(err, TK_ENOMEM, "out of memory");
+    size_t ne = tk_curve_edge_count(c);
+    f->nedges = ne;
+    f->nvert = c->nvert;
+    f->ncomp = c->ncomp;
+    size_t m = ne ? ne : 1;
+    f->head = malloc(m * sizeof(size_t));
+    f->tail = malloc(m * sizeof(size_t));
+    f->comp = malloc(m * sizeof(size_t));
+    f->local = malloc(m * sizeof(size_t));
+    f->prev = malloc(m * sizeof(size_t));
+    f->next = malloc(m * sizeof(size_t));
+    f->comp_first_edge = malloc((c->ncomp + 1) * sizeof(size_t));
+    f->comp_closed = malloc(c->ncomp * sizeof(bool));
+    f->prefix = malloc((c->nvert + c->ncomp) * sizeof(double));
+    f->prefix_offset = malloc(c->ncomp * sizeof(size_t));
+    f->nodes = malloc(2 * m * sizeof(tree_node));
+    if (!f->head || !f->tail || !f->comp || !f->local || !f->prev || !f->next ||
+        !f->comp_first_edge || !f->comp_closed || !f->prefix || !f->prefix_offset ||
+        !f->nodes) {
+        tk_strut_finder_free(&f);
+        return tk_error_set(err, TK_ENOMEM, "out of memory for the strut tree (%zu edges)", ne);
+    }
+    size_t e = 0;
+    for (size_t k = 0; k < c->ncomp; k++) {
+        size_t n = tk_curve_comp_edges(c, k);
+        f->comp_first_edge[k] = e;
+        f->comp_closed[k] = c->closed[k];
+        f->prefix_offset[k] = c->offset[k] + k;
+        for (size_t i = 0; i < n; i++, e++) {
+            f->head[e] = tk_curve_vertex_index(c, k, i);
+            f->tail[e] = tk_curve_vertex_index(c, k, i + 1);
+            f->comp[e] = k;
+            f->local[e] = i;
+            if (c->closed[k]) {
+                f->prev[e] = f->comp_first_edge[k] + (i + n - 1) % n;
+                f->next[e] = f->comp_first_edge[k] + (i + 1) % n;
+            } else {
+                f->prev[e] = i > 0 ? e - 1 : NO_EDGE;
+                f->next[e] = i + 1 < n ? e + 1 : NO_EDGE;
+            }
+        }
+    }
+    f->comp_first_edge[c->ncomp] = e;
+    if (ne > 0)
+        build_node(f, 0, ne);
+    *out = f;
+    tk_strut_finder_refit(f, c);
+    return TK_OK;
+}
+
+void tk_strut_finder_refit(tk_strut_finder *f, const tk_curve *c)
+{
+    /* Children are created after their parents, so a reverse sweep sees
+     * both children of a node before the node. */
+    for (size_t id = f->nnodes; id-- > 0;) {
+        tree_node *n = &f->nodes[id];
+        if (n->left) {
+            const tree_node *l = &f->nodes[n->left], *r = &f->nodes[n->right];
+            for (int k = 0; k < 3; k++) {
+                n->lo[k] = fmin(l->lo[k], r->lo[k]);
+                n->hi[k] = fmax(l->hi[k], r->hi[k]);
+            }
+            continue;
+        }
+        for (int k = 0; k < 3; k++) {
+            n->lo[k] = INFINITY;
+            n->hi[k] = -INFINITY;
+        }
+        for (size_t e = n->first; e < n->end; e++) {
+            const double *a = c->xyz + 3 * f->head[e], *b = c->xyz + 3 * f->tail[e];
+            for (int k = 0; k < 3; k++) {
+                n->lo[k] = fmin(n->lo[k], fmin(a[k], b[k]));
+                n->hi[k] = fmax(n->hi[k], fmax(a[k], b[k]));
+            }
+        }
+    }
+}
+
+/* Vertex weights for the arc rule, summed per component: prefix[k] is the
+ * sum of the weights of the component's vertices 0 .. k-1. */
+static void fill_prefix(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule,
+                        double tau)
+{
+    for (size_t k = 0; k < c->ncomp; k++) {
+        size_t n = tk_curve_comp_vertices(c, k), base = c->offset[k];
+        double *p = f->prefix + f->prefix_offset[k];
+        p[0] = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            double w = 0.0;
+            if (c->closed[k] || (i > 0 && i + 1 < n)) {
+                const double *prev = c->xyz + 3 * (base + (i + n - 1) % n);
+                const double *v = c->xyz + 3 * (base + i);
+                const double *next = c->xyz + 3 * (base + (i + 1) % n);
+                if (rule == TK_ARC_FENCHEL) {
+                    w = tk_vertex_turning(prev, v, next);
+                } else {
+                    double la = sqrt((v[0] - prev[0]) * (v[0] - prev[0]) +
+                                     (v[1] - prev[1]) * (v[1] - prev[1]) +
+                                     (v[2] - prev[2]) * (v[2] - prev[2]));
+                    double lb = sqrt((next[0] - v[0]) * (next[0] - v[0]) +
+                                     (next[1] - v[1]) * (next[1] - v[1]) +
+                                     (next[2] - v[2]) * (next[2] - v[2]));
+                    /* The most a vertex can turn with 2 minrad >= tau
+                     * (equation 3 solved for theta). */
+                    w = 2.0 * atan(fmin(la, lb) / tau);
+                }
+            }
+            p[i + 1] = p[i] + w;
+        }
+    }
+}
+
+/* Total weight of the vertices strictly between local edges i < j of a
+ * component, walking forwards: vertices i+1 .. j. */
+static double forward_turn(const tk_strut_finder *f, size_t comp, size_t i, size_t j)
+{
+    const double *p = f->prefix + f->prefix_offset[comp];
+    return p[j + 1] - p[i + 1];
+}
+
+static double comp_total_turn(const tk_strut_finder *f, const tk_curve *c, size_t comp)
+{
+    return f->prefix[f->prefix_offset[comp] + tk_curve_comp_vertices(c, comp)];
+}
+
+static bool edges_adjacent(const tk_strut_finder *f, size_t i, size_t j)
+{
+    return f->next[i] == j || f->prev[i] == j;
+}
+
+/* The arc rule for global edges i != j (prefix must be filled). */
+static bool pair_allowed(const tk_strut_finder *f, const tk_curve *c, size_t i, size_t j)
+{
+    if (f->comp[i] != f->comp[j])
+        return true;
+    if (i == j || edges_adjacent(f, i, j))
+        return false;
+    size_t comp = f->comp[i];
+    size_t a = f->local[i], b = f->local[j];
+    if (a > b) {
+        size_t t = a;
+        a = b;
+        b = t;
+    }
+    double fwd = forward_turn(f, comp, a, b);
+    if (fwd < ARC_TURN_NEEDED)
+        return false;
+    if (!f->comp_closed[comp])
+        return true;
+    return comp_total_turn(f, c, comp) - fwd >= ARC_TURN_NEEDED;
+}
+
+/* Whether some pair of edges of the two nodes may pass the arc rule: an
+ * upper bound of min(forward, backward) turn over the node pair. */
+static bool nodes_may_pass(const tk_strut_finder *f, const tk_curve *c,
+                           const tree_node *x, const tree_node *y)
+{
+    if (x->comp == NO_COMP || y->comp == NO_COMP || x->comp != y->comp)
+        return true;
+    size_t comp = x->comp, base = f->comp_first_edge[comp];
+    size_t x0 = x->first - base, x1 = x->end - 1 - base;
+    size_t y0 = y->first - base, y1 = y->end - 1 - base;
+    size_t lo0 = x0 < y0 ? x0 : y0, hi1 = x1 > y1 ? x1 : y1;
+    /* Largest forward turn: from the first edge of either node to the last. */
+    double max_fwd = lo0 < hi1 ? forward_turn(f, comp, lo0, hi1) : 0.0;
+    if (max_fwd < ARC_TURN_NEEDED)
+        return false;
+    if (!f->comp_closed[comp])
+        return true;
+    /* Smallest forward turn between the nodes (0 when they overlap). */
+    double min_fwd = 0.0;
+    if (x1 < y0)
+        min_fwd = forward_turn(f, comp, x1, y0);
+    else if (y1 < x0)
+        min_fwd = forward_turn(f, comp, y1, x0);
+    return comp_total_turn(f, c, comp) - min_fwd >= ARC_TURN_NEEDED;
+}
+
+static void edge_closest(const tk_strut_finder *f, const tk_curve *c, size_t i,
+                         size_t j, tk_closest *out)
+{
+    tk_segment_closest(c->xyz + 3 * f->head[i], c->xyz + 3 * f->tail[i],
+                       c->xyz + 3 * f->head[j], c->xyz + 3 * f->tail[j], out);
+}
+
+/* The edges containing a closest point at parameter s of edge e, the edge
+ * that starts at the point first (the preferred owner). */
+static size_t edges_at(const tk_strut_finder *f, size_t e, double s, size_t out[2])
+{
+    if (s == 0.0 && f->prev[e] != NO_EDGE) {
+        out[0] = e;
+        out[1] = f->prev[e];
+        return 2;
+    }
+    if (s == 1.0 && f->next[e] != NO_EDGE) {
+        out[0] = f->next[e];
+        out[1] = e;
+        return 2;
+    }
+    out[0] = e;
+    return 1;
+}
+
+/* Decides whether edge pair (i, j) reports contact `cl`: it must be a local
+ * minimum of the self-distance (no edge pair through p and q comes closer)
+ * and (i, j) must be its owner.  See the comment at the top. */
+static bool owns_contact(const tk_strut_finder *f, const tk_curve *c, size_t i,
+                         size_t j, const tk_closest *cl)
+{
+    size_t pe[2], qe[2];
+    size_t np = edges_at(f, i, cl->s, pe), nq = edges_at(f, j, cl->t, qe);
+    if (np == 1 && nq == 1)
+        return true;
+    double floor = cl->dist * (1.0 - SAME_CONTACT_REL);
+    bool owner_found = false, we_own = false;
+    for (size_t a = 0; a < np; a++) {
+        for (size_t b = 0; b < nq; b++) {
+            size_t x = pe[a], y = qe[b];
+            bool ours = (x == i && y == j) || (x == j && y == i);
+            if (!ours) {
+                if (x == y)
+                    return false;
+                tk_closest other;
+                edge_closest(f, c, x, y, &other);
+                if (other.dist < floor)
+                    return false;
+            }
+            if (!owner_found && pair_allowed(f, c, x, y)) {
+                owner_found = true;
+                we_own = ours;
+            }
+        }
+    }
+    return we_own;
+}
+
+static void strut_from(const tk_strut_finder *f, size_t i, size_t j,
+                       const tk_closest *cl, tk_strut *s)
+{
+    s->comp[0] = f->comp[i];
+    s->edge[0] = f->local[i];
+    s->comp[1] = f->comp[j];
+    s->edge[1] = f->local[j];
+    s->s = cl->s;
+    s->t = cl->t;
+    memcpy(s->p, cl->p, sizeof s->p);
+    memcpy(s->q, cl->q, sizeof s->q);
+    s->length = cl->dist;
+    s->force = 0.0;
+}
+
+/* Tests global edges i < j. */
+static void test_pair(query *qy, size_t i, size_t j)
+{
+    tk_strut_finder *f = qy->f;
+    if (!pair_allowed(f, qy->c, i, j))
+        return;
+    tk_closest cl;
+    edge_closest(f, qy->c, i, j, &cl);
+    if (qy->shortest_mode ? !(cl.dist < qy->bound) : !(cl.dist <= qy->bound))
+        return;
+    if (!owns_contact(f, qy->c, i, j, &cl))
+        return;
+    if (qy->shortest_mode) {
+        qy->bound = cl.dist;
+        strut_from(f, i, j, &cl, &qy->best);
+        return;
+    }
+    tk_strut s;
+    strut_from(f, i, j, &cl, &s);
+    if (list_push(qy->out, &s) != TK_OK)
+        qy->status = TK_ENOMEM;
+}
+
+static double box_gap2(const tree_node *x, const tree_node *y)
+{
+    double g2 = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double g = fmax(x->lo[k] - y->hi[k], y->lo[k] - x->hi[k]);
+        if (g > 0.0)
+            g2 += g * g;
+    }
+    return g2;
+}
+
+static bool node_pair_pruned(const query *qy, const tree_node *x, const tree_node *y)
+{
+    double g2 = box_gap2(x, y);
+    double b2 = qy->bound * qy->bound;
+    if (qy->shortest_mode ? g2 >= b2 : g2 > b2)
+        return true;
+    return !nodes_may_pass(qy->f, qy->c, x, y);
+}
+
+static void visit(query *qy, size_t xi, size_t yi)
+{
+    if (qy->status != TK_OK)
+        return;
+    const tree_node *x = &qy->f->nodes[xi], *y = &qy->f->nodes[yi];
+    if (node_pair_pruned(qy, x, y))
+        return;
+    if (!x->left && !y->left) {
+        for (size_t i = x->first; i < x->end; i++)
+            for (size_t j = (xi == yi ? i + 1 : y->first); j < y->end; j++)
+                test_pair(qy, i < j ? i : j, i < j ? j : i);
+        return;
+    }
+    size_t pairs[3][2];
+    size_t np = 0;
+    if (xi == yi) {
+        pairs[0][0] = x->left, pairs[0][1] = x->left;
+        pairs[1][0] = x->left, pairs[1][1] = x->right;
+        pairs[2][0] = x->right, pairs[2][1] = x->right;
+        np = 3;
+    } else if (!y->left || (x->left && x->end - x->first >= y->end - y->first)) {
+        pairs[0][0] = x->left, pairs[0][1] = yi;
+        pairs[1][0] = x->right, pairs[1][1] = yi;
+        np = 2;
+    } else {
+        pairs[0][0] = xi, pairs[0][1] = y->left;
+        pairs[1][0] = xi, pairs[1][1] = y->right;
+        np = 2;
+    }
+    if (qy->shortest_mode) {
+        /* Nearest pairs first, so the bound shrinks early. */
+        double gap[3];
+        for (size_t k = 0; k < np; k++)
+            gap[k] = box_gap2(&qy->f->nodes[pairs[k][0]], &qy->f->nodes[pairs[k][1]]);
+        for (size_t a = 1; a < np; a++)
+            for (size_t b = a; b > 0 && gap[b] < gap[b - 1]; b--) {
+                double g = gap[b];
+                gap[b] = gap[b - 1];
+                gap[b - 1] = g;
+                size_t p0 = pairs[b][0], p1 = pairs[b][1];
+                pairs[b][0] = pairs[b - 1][0];
+                pairs[b][1] = pairs[b - 1][1];
+                pairs[b - 1][0] = p0;
+                pairs[b - 1][1] = p1;
+            }
+    }
+    for (size_t k = 0; k < np; k++)
+        visit(qy, pairs[k][0], pairs[k][1]);
+}
+
+static int compare_struts(const void *pa, const void *pb)
+{
+    const tk_strut *a = pa, *b = pb;
+    for (int k = 0; k < 2; k++) {
+        if (a->comp[k] != b->comp[k])
+            return a->comp[k] < b->comp[k] ? -1 : 1;
+        if (a->edge[k] != b->edge[k])
+            return a->edge[k] < b->edge[k] ? -1 : 1;
+    }
+    if (a->s != b->s)
+        return a->s < b->s ? -1 : 1;
+    if (a->t != b->t)
+        return a->t < b->t ? -1 : 1;
+    return 0;
+}
+
+static int check_counts(const tk_strut_finder *f, const tk_curve *c, tk_error *err)
+{
+    if (c->nvert != f->nvert || c->ncomp != f->ncomp || tk_curve_edge_count(c) != f->nedges)
+        return tk_error_set(err, TK_EINVAL, "the curve does not match the strut finder");
+    return TK_OK;
+}
+
+int tk_strut_finder_find(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule,
+                         double tau, double bound, tk_strut_list *out, tk_error *err)
+{
+    int rc = check_counts(f, c, err);
+    if (rc)
+        return rc;
+    if (rule == TK_ARC_ADMISSIBLE && !(tau > 0.0))
+        return tk_error_set(err, TK_EINVAL, "the diameter must be positive (got %g)", tau);
+    fill_prefix(f, c, rule, tau);
+    size_t start = out->count;
+    query qy = {f, c, rule, bound, false, {{0}}, out, TK_OK};
+    if (f->nedges > 1 && bound >= 0.0)
+        visit(&qy, 0, 0);
+    if (qy.status != TK_OK)
+        return tk_error_set(err, qy.status, "out of memory listing struts");
+    qsort(out->items + start, out->count - start, sizeof *out->items, compare_struts);
+    return TK_OK;
+}
+
+int tk_strut_finder_shortest(tk_strut_finder *f, const tk_curve *c, double *shortest,
+                             tk_strut *where, tk_error *err)
+{
+    int rc = check_counts(f, c, err);
+    if (rc)
+        return rc;
+    fill_prefix(f, c, TK_ARC_FENCHEL, 0.0);
+    query qy = {f, c, TK_ARC_FENCHEL, INFINITY, true, {{0}}, NULL, TK_OK};
+    if (f->nedges > 1)
+        visit(&qy, 0, 0);
+    *shortest = qy.bound;
+    if (where)
+        *where = qy.best;
+    return TK_OK;
+}
+
+int tk_struts_find_brute(const tk_curve *c, tk_arc_rule rule, double tau, double bound,
+                         tk_strut_list *out, tk_error *err)
+{
+    if (rule == TK_ARC_ADMISSIBLE && !(tau > 0.0))
+        return tk_error_set(err, TK_EINVAL, "the diameter must be positive (got %g)", tau);
+    tk_strut_finder *f = NULL;
+    int rc = tk_strut_finder_new(c, &f, err);
+    if (rc)
+        return rc;
+    fill_prefix(f, c, rule, tau);
+    size_t start = out->count;
+    query qy = {f, c, rule, bound, false, {{0}}, out, TK_OK};
+    for (size_t i = 0; i < f->nedges && qy.status == TK_OK; i++)
+        for (size_t j = i + 1; j < f->nedges; j++)
+            test_pair(&qy, i, j);
+    tk_strut_finder_free(&f);
+    if (qy.status != TK_OK)
+        return tk_error_set(err, qy.status, "out of memory listing struts");
+    qsort(out->items + start, out->count - start, sizeof *out->items, compare_struts);
+    return TK_OK;
+}
+
+double tk_struts_shortest_brute(const tk_curve *c, tk_strut *where)
+{
+    tk_strut_finder *f = NULL;
+    if (tk_strut_finder_new(c, &f, NULL) != TK_OK)
+        return NAN;
+    fill_prefix(f, c, TK_ARC_FENCHEL, 0.0);
+    query qy = {f, c, TK_ARC_FENCHEL, INFINITY, true, {{0}}, NULL, TK_OK};
+    for (size_t i = 0; i < f->nedges; i++)
+        for (size_t j = i + 1; j < f->nedges; j++)
+            test_pair(&qy, i, j);
+    tk_strut_finder_free(&f);
+    if (where)
+        *where = qy.best;
+    return qy.bound;
+}
+
+bool tk_struts_pair_allowed(const tk_curve *c, tk_arc_rule rule, double tau, size_t i,
+                            size_t j)
+{
+    tk_strut_finder *f = NULL;
+    if (tk_strut_finder_new(c, &f, NULL) != TK_OK)
+        return false;
+    fill_prefix(f, c, rule, tau);
+    bool ok = pair_allowed(f, c, i, j);
+    tk_strut_finder_free(&f);
+    return ok;
+}
+
+int tk_kinks_find(const tk_curve *c, double bound, tk_kink **out, size_t *count,
+                  tk_error *err)
+{
+    *out = NULL;
+    *count = 0;
+    size_t cap = 0;
+    for (size_t comp = 0; comp < c->ncomp; comp++) {
+        size_t n = tk_curve_comp_vertices(c, comp), base = c->offset[comp];
+        size_t first = c->closed[comp] ? 0 : 1;
+        size_t last = c->closed[comp] ? n : (n >= 1 ? n - 1 : 0);
+        for (size_t k = first; k < last; k++) {
+            double r = tk_vertex_minrad(c->xyz + 3 * (base + (k + n - 1) % n),
+                                        c->xyz + 3 * (base + k),
+                                        c->xyz + 3 * (base + (k + 1) % n));
+            if (!(2.0 * r <= bound))
+                continue;
+            if (*count == cap) {
+                cap = cap ? 2 * cap : 16;
+                tk_kink *grown = realloc(*out, cap * sizeof *grown);
+                if (!grown) {
+                    free(*out);
+                    *out = NULL;
+                    *count = 0;
+                    return tk_error_set(err, TK_ENOMEM, "out of memory listing kinks");
+                }
+                *out = grown;
+            }
+            (*out)[(*count)++] = (tk_kink){comp, k, r, 0.0};
+        }
+    }
+    return TK_OK;
+}
