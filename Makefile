@@ -25,7 +25,7 @@ endif
 CHECK_CFLAGS := $(shell pkg-config --cflags check 2>/dev/null)
 CHECK_LIBS := $(shell pkg-config --libs check 2>/dev/null)
 
-CPPFLAGS += -Iinclude -I/usr/include/suitesparse -D_XOPEN_SOURCE=700
+CPPFLAGS += -Iinclude -Itests/support -I/usr/include/suitesparse -D_XOPEN_SOURCE=700
 CFLAGS += -std=c11 $(OPT) -g -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
 	-Wmissing-prototypes -Wno-missing-field-initializers -MMD -MP $(SAN_FLAGS)
 LDFLAGS += $(SAN_FLAGS)

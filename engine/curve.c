@@ -243,3 +243,311 @@ int tk_curve_validate(const tk_curve *c, tk_error *err)
     }
     return TK_OK;
 }
+
+/* Solves the tridiagonal system with sub-diagonal a, diagonal b,
+ * super-diagonal c (a[0], c[n-1] unused) for three right-hand sides stored
+ * as rhs[3*i + k], in place.  The spline matrices are strictly diagonally
+ * dominant, so no pivoting is needed.  work has n entries. */
+static void solve_tridiagonal(size_t n, const double *a, const double *b,
+                              const double *c, double *rhs, double *work)
+{
+    double beta = b[0];
+    work[0] = 0.0;
+    for (int k = 0; k < 3; k++)
+        rhs[k] /= beta;
+    for (size_t i = 1; i < n; i++) {
+        work[i] = c[i - 1] / beta;
+        beta = b[i] - a[i] * work[i];
+        for (int k = 0; k < 3; k++)
+            rhs[3 * i + k] = (rhs[3 * i + k] - a[i] * rhs[3 * (i - 1) + k]) / beta;
+    }
+    for (size_t i = n - 1; i-- > 0;)
+        for (int k = 0; k < 3; k++)
+            rhs[3 * i + k] -= work[i + 1] * rhs[3 * (i + 1) + k];
+}
+
+/* A cubic spline through the points y[0..n-1] (closed: periodic, the
+ * interval after y[n-1] returning to y[0]), parametrised by chord length. */
+typedef struct spline {
+    size_t n, intervals;
+    const double *y;
+    double *u;  /* knots, intervals + 1 */
+    double *m;  /* second derivatives, 3 per knot (n of them) */
+} spline;
+
+static int spline_fit(spline *sp, const double *y, size_t n, bool closed)
+{
+    size_t ni = closed ? n : n - 1;
+    sp->n = n;
+    sp->intervals = ni;
+    sp->y = y;
+    sp->u = malloc((ni + 1) * sizeof *sp->u);
+    sp->m = calloc(3 * n, sizeof *sp->m);
+    double *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+    double *c = malloc(n * sizeof *c), *work = malloc(n * sizeof *work);
+    double *z = calloc(3 * n, sizeof *z);
+    int rc = TK_OK;
+    if (!sp->u || !sp->m || !a || !b || !c || !work || !z) {
+        rc = TK_ENOMEM;
+        goto done;
+    }
+    sp->u[0] = 0.0;
+    for (size_t i = 0; i < ni; i++)
+        sp->u[i + 1] = sp->u[i] + distance3(y + 3 * i, y + 3 * ((i + 1) % n));
+    /* Continuity of the first derivative at knot i:
+     *   h[i-1] M[i-1] + 2 (h[i-1] + h[i]) M[i] + h[i] M[i+1]
+     *     = 6 ((y[i+1] - y[i]) / h[i] - (y[i] - y[i-1]) / h[i-1]). */
+    if (closed) {
+        /* Periodic: a cyclic system, solved with Sherman-Morrison on top of
+         * the plain tridiagonal solve. */
+        for (size_t i = 0; i < n; i++) {
+            size_t ip = (i + n - 1) % n, in = (i + 1) % n;
+            double h0 = sp->u[ip + 1] - sp->u[ip], h1 = sp->u[i + 1] - sp->u[i];
+            a[i] = h0;
+            b[i] = 2.0 * (h0 + h1);
+            c[i] = h1;
+            for (int k = 0; k < 3; k++)
+                sp->m[3 * i + k] = 6.0 * ((y[3 * in + k] - y[3 * i + k]) / h1 -
+                                          (y[3 * i + k] - y[3 * ip + k]) / h0);
+        }
+        double corner_lo = a[0], corner_hi = c[n - 1], gamma = -b[0];
+        double b0 = b[0], bn = b[n - 1];
+        b[0] = b0 - gamma;
+        b[n - 1] = bn - corner_lo * corner_hi / gamma;
+        z[0] = gamma;
+        z[3 * (n - 1)] = corner_hi;
+        /* z holds the correction vector in its first coordinate slot. */
+        double *zz = calloc(3 * n, sizeof *zz);
+        if (!zz) {
+            rc = TK_ENOMEM;
+            goto done;
+        }
+        for (size_t i = 0; i < n; i++)
+            zz[3 * i] = zz[3 * i + 1] = zz[3 * i + 2] = z[3 * i];
+        solve_tridiagonal(n, a, b, c, sp->m, work);
+        solve_tridiagonal(n, a, b, c, zz, work);
+        for (int k = 0; k < 3; k++) {
+            double vx = sp->m[k] + corner_lo / gamma * sp->m[3 * (n - 1) + k];
+            double vz = zz[k] + corner_lo / gamma * zz[3 * (n - 1) + k];
+            double factor = vx / (1.0 + vz);
+            for (size_t i = 0; i < n; i++)
+                sp->m[3 * i + k] -= factor * zz[3 * i + k];
+        }
+        free(zz);
+    } else if (n > 2) {
+        /* Natural: M[0] = M[n-1] = 0, the interior knots solved. */
+        size_t ninner = n - 2;
+        for (size_t j = 0; j < ninner; j++) {
+            size_t i = j + 1;
+            double h0 = sp->u[i] - sp->u[i - 1], h1 = sp->u[i + 1] - sp->u[i];
+            a[j] = h0;
+            b[j] = 2.0 * (h0 + h1);
+            c[j] = h1;
+            for (int k = 0; k < 3; k++)
+                z[3 * j + k] = 6.0 * ((y[3 * (i + 1) + k] - y[3 * i + k]) / h1 -
+                                      (y[3 * i + k] - y[3 * (i - 1) + k]) / h0);
+        }
+        solve_tridiagonal(ninner, a, b, c, z, work);
+        memcpy(sp->m + 3, z, 3 * ninner * sizeof *z);
+    }
+done:
+    free(a);
+    free(b);
+    free(c);
+    free(work);
+    free(z);
+    return rc;
+}
+
+static void spline_free(spline *sp)
+{
+    free(sp->u);
+    free(sp->m);
+    sp->u = sp->m = NULL;
+}
+
+/* Evaluates the spline at parameter x in [0, u[intervals]]. */
+static void spline_eval(const spline *sp, double x, double out[3])
+{
+    size_t lo = 0, hi = sp->intervals;
+    while (hi - lo > 1) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (sp->u[mid] <= x)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    size_t i = lo, j = (lo + 1) % sp->n;
+    double h = sp->u[i + 1] - sp->u[i];
+    double s = x - sp->u[i], r = h - s;
+    for (int k = 0; k < 3; k++) {
+        double mi = sp->m[3 * i + k], mj = sp->m[3 * j + k];
+        out[k] = mi * r * r * r / (6.0 * h) + mj * s * s * s / (6.0 * h) +
+                 (sp->y[3 * i + k] / h - mi * h / 6.0) * r +
+                 (sp->y[3 * j + k] / h - mj * h / 6.0) * s;
+    }
+}
+
+/* Places count points at equal arclength along the spline, measured on a
+ * dense sampling of it (fine enough that the spacing is equal to well
+ * under a percent). */
+static int spline_resample(const spline *sp, bool closed, size_t count, double *out)
+{
+    size_t dense = 32 * sp->intervals;
+    if (dense < 8 * count)
+        dense = 8 * count;
+    double total_u = sp->u[sp->intervals];
+    double *arc = malloc((dense + 1) * sizeof *arc);
+    if (!arc)
+        return TK_ENOMEM;
+    double prev[3], cur[3];
+    spline_eval(sp, 0.0, prev);
+    arc[0] = 0.0;
+    for (size_t k = 1; k <= dense; k++) {
+        spline_eval(sp, total_u * (double)k / (double)dense, cur);
+        arc[k] = arc[k - 1] + distance3(prev, cur);
+        memcpy(prev, cur, sizeof prev);
+    }
+    size_t spans = closed ? count : count - 1;
+    size_t seg = 0;
+    for (size_t v = 0; v < count; v++) {
+        double target = arc[dense] * (double)v / (double)spans;
+        while (seg + 1 < dense && arc[seg + 1] < target)
+            seg++;
+        double len = arc[seg + 1] - arc[seg];
+        double frac = len > 0.0 ? (target - arc[seg]) / len : 0.0;
+        double x = total_u * ((double)seg + frac) / (double)dense;
+        if (!closed && v == count - 1)
+            x = total_u;
+        spline_eval(sp, x, out + 3 * v);
+    }
+    free(arc);
+    return TK_OK;
+}
+
+int tk_curve_resample(const tk_curve *src, const size_t *counts, tk_curve **out,
+                      tk_error *err)
+{
+    *out = NULL;
+    int rc = tk_curve_validate(src, err);
+    if (rc)
+        return rc;
+    for (size_t i = 0; i < src->ncomp; i++)
+        if (counts[i] < (src->closed[i] ? 3u : 2u))
+            return tk_error_set(err, TK_EINVAL,
+                                "component %zu cannot have %zu vertices", i, counts[i]);
+    rc = tk_curve_new(out, src->ncomp, counts, src->closed, err);
+    if (rc)
+        return rc;
+    for (size_t i = 0; i < src->ncomp && rc == TK_OK; i++) {
+        spline sp = {0};
+        size_t n = tk_curve_comp_vertices(src, i);
+        rc = spline_fit(&sp, src->xyz + 3 * src->offset[i], n, src->closed[i]);
+        if (rc == TK_OK)
+            rc = spline_resample(&sp, src->closed[i], counts[i],
+                                 (*out)->xyz + 3 * (*out)->offset[i]);
+        spline_free(&sp);
+    }
+    if (rc == TK_OK)
+        rc = tk_curve_validate(*out, err);
+    else
+        tk_error_set(err, rc, "out of memory resampling");
+    if (rc)
+        tk_curve_free(out);
+    return rc;
+}
+
+int tk_curve_resample_total(const tk_curve *src, size_t total, tk_curve **out,
+                            tk_error *err)
+{
+    *out = NULL;
+    size_t minimum = 0;
+    for (size_t i = 0; i < src->ncomp; i++)
+        minimum += src->closed[i] ? 3 : 2;
+    if (total < minimum)
+        return tk_error_set(err, TK_EINVAL, "%zu vertices are too few for %zu components",
+                            total, src->ncomp);
+    size_t *counts = calloc(src->ncomp, sizeof *counts);
+    double *share = calloc(src->ncomp, sizeof *share);
+    if (!counts || !share) {
+        free(counts);
+        free(share);
+        return tk_error_set(err, TK_ENOMEM, "out of memory");
+    }
+    double length = tk_curve_length(src);
+    size_t given = 0;
+    for (size_t i = 0; i < src->ncomp; i++) {
+        share[i] = (double)total * tk_curve_comp_length(src, i) / length;
+        size_t least = src->closed[i] ? 3 : 2;
+        counts[i] = (size_t)floor(share[i]);
+        if (counts[i] < least)
+            counts[i] = least;
+        given += counts[i];
+    }
+    /* Largest remainders get the vertices left over; components above their
+     * share give back when the minimums overshot. */
+    while (given < total) {
+        size_t best = 0;
+        double gap = -INFINITY;
+        for (size_t i = 0; i < src->ncomp; i++)
+            if (share[i] - (double)counts[i] > gap) {
+                gap = share[i] - (double)counts[i];
+                best = i;
+            }
+        counts[best]++;
+        given++;
+    }
+    while (given > total) {
+        size_t best = 0;
+        double excess = -INFINITY;
+        for (size_t i = 0; i < src->ncomp; i++)
+            if (counts[i] > (src->closed[i] ? 3u : 2u) &&
+                (double)counts[i] - share[i] > excess) {
+                excess = (double)counts[i] - share[i];
+                best = i;
+            }
+        counts[best]--;
+        given--;
+    }
+    int rc = tk_curve_resample(src, counts, out, err);
+    free(counts);
+    free(share);
+    return rc;
+}
+
+int tk_curve_equilateralize(tk_curve *c, tk_error *err)
+{
+    int rc = tk_curve_validate(c, err);
+    if (rc)
+        return rc;
+    for (size_t i = 0; i < c->ncomp; i++) {
+        size_t n = tk_curve_comp_vertices(c, i), ne = tk_curve_comp_edges(c, i);
+        double *x = c->xyz + 3 * c->offset[i];
+        double *old = malloc(3 * n * sizeof *old);
+        double *arc = malloc((ne + 1) * sizeof *arc);
+        if (!old || !arc) {
+            free(old);
+            free(arc);
+            return tk_error_set(err, TK_ENOMEM, "out of memory");
+        }
+        memcpy(old, x, 3 * n * sizeof *old);
+        arc[0] = 0.0;
+        for (size_t k = 0; k < ne; k++)
+            arc[k + 1] = arc[k] + distance3(old + 3 * k, old + 3 * ((k + 1) % n));
+        size_t seg = 0;
+        for (size_t v = 1; v < n; v++) {
+            if (!c->closed[i] && v == n - 1)
+                break;
+            double target = arc[ne] * (double)v / (double)ne;
+            while (seg + 1 < ne && arc[seg + 1] < target)
+                seg++;
+            double frac = (target - arc[seg]) / (arc[seg + 1] - arc[seg]);
+            const double *a = old + 3 * seg, *b = old + 3 * ((seg + 1) % n);
+            for (int k = 0; k < 3; k++)
+                x[3 * v + k] = a[k] + frac * (b[k] - a[k]);
+        }
+        free(old);
+        free(arc);
+    }
+    return TK_OK;
+}

@@ -190,11 +190,14 @@ double tk_vertex_minrad(const double prev[3], const double v[3],
     sub3(v, prev, a);
     sub3(next, v, b);
     cross3(a, b, x);
-    double la = sqrt(dot3(a, a)), lb = sqrt(dot3(b, b));
+    double la = sqrt(dot3(a, a)), lb = sqrt(dot3(b, b)), ab = dot3(a, b);
     double sin_term = sqrt(dot3(x, x));
     if (!(sin_term > 0.0))
-        return dot3(a, b) >= 0.0 ? INFINITY : 0.0;
-    return fmin(la, lb) * (la * lb + dot3(a, b)) / (2.0 * sin_term);
+        return ab >= 0.0 ? INFINITY : 0.0;
+    /* For turns past a right angle |a||b| + a.b cancels; the identity
+     * (|a||b| + a.b)(|a||b| - a.b) = |a x b|^2 avoids it. */
+    double h = ab >= 0.0 ? (la * lb + ab) / sin_term : sin_term / (la * lb - ab);
+    return 0.5 * fmin(la, lb) * h;
 }
 
 /* The gradient of equation (3), the quantity whose gradient the paper
@@ -215,17 +218,27 @@ double tk_vertex_minrad_gradient(const double prev[3], const double v[3],
     memset(grad, 0, 9 * sizeof *grad);
     if (!(den > 0.0))
         return ab >= 0.0 ? INFINITY : 0.0;
-    double num = la * lb + ab;
+    /* h = cot(theta/2) as num/den: num = |a||b| + a.b, den = |a x b| for
+     * turns up to a right angle; num = |a x b|, den = |a||b| - a.b past it
+     * (the same value without cancellation). */
+    bool sharp = ab < 0.0;
+    double cross_len = den;
+    double num = sharp ? cross_len : la * lb + ab;
+    if (sharp)
+        den = la * lb - ab;
     double h = num / den;
     bool a_shorter = la <= lb;
     double len = a_shorter ? la : lb;
 
     double ga[3], gb[3];
     for (int k = 0; k < 3; k++) {
-        double dnum_a = a[k] / la * lb + b[k];
-        double dnum_b = b[k] / lb * la + a[k];
-        double dden_a = (a[k] * lb * lb - ab * b[k]) / den;
-        double dden_b = (b[k] * la * la - ab * a[k]) / den;
+        /* derivatives of |a||b| + a.b, of |a||b| - a.b and of |a x b| */
+        double dsum_a = a[k] / la * lb + b[k], dsum_b = b[k] / lb * la + a[k];
+        double ddiff_a = a[k] / la * lb - b[k], ddiff_b = b[k] / lb * la - a[k];
+        double dcross_a = (a[k] * lb * lb - ab * b[k]) / cross_len;
+        double dcross_b = (b[k] * la * la - ab * a[k]) / cross_len;
+        double dnum_a = sharp ? dcross_a : dsum_a, dnum_b = sharp ? dcross_b : dsum_b;
+        double dden_a = sharp ? ddiff_a : dcross_a, dden_b = sharp ? ddiff_b : dcross_b;
         double dh_a = (dnum_a * den - num * dden_a) / (den * den);
         double dh_b = (dnum_b * den - num * dden_b) / (den * den);
         ga[k] = 0.5 * len * dh_a + (a_shorter ? 0.5 * h * a[k] / la : 0.0);

@@ -110,9 +110,10 @@ int tk_curve_resample(const tk_curve *src, const size_t *counts,
 int tk_curve_resample_total(const tk_curve *src, size_t total, tk_curve **out,
                             tk_error *err);
 
-/* Moves vertices along the polygon itself (no smoothing) so that each
- * component's edges have equal length; the polygon's shape is kept up to
- * the cut corners.  In place; vertex counts unchanged. */
+/* Moves vertices along the polygon itself (no smoothing) to equal arclength
+ * spacing on each component (open components keep their end points), so
+ * the edges come out equal up to the corners they cut.  In place; vertex
+ * counts unchanged. */
 int tk_curve_equilateralize(tk_curve *c, tk_error *err);
 
 #endif

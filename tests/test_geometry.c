@@ -1,0 +1,365 @@
+/* Geometry: edge distances against dense sampling, gradients (equations 6,
+ * 7 and 14) against central finite differences, exact minrad values. */
+#include <check.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "support.h"
+#include "tk/geometry.h"
+
+/* Largest component difference over largest component magnitude. */
+static double vec_reldiff(const double *a, const double *b, size_t n)
+{
+    double diff = 0.0, mag = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        diff = fmax(diff, fabs(a[i] - b[i]));
+        mag = fmax(mag, fmax(fabs(a[i]), fabs(b[i])));
+    }
+    return mag > 0.0 ? diff / mag : diff;
+}
+
+static double seg_dist(const double *x)
+{
+    tk_closest c;
+    tk_segment_closest(x, x + 3, x + 6, x + 9, &c);
+    return c.dist;
+}
+
+/* Distance from point x to segment (b0, b1), by projection. */
+static double point_segment(const double *x, const double *b0, const double *b1)
+{
+    double d[3], r[3], dd = 0, rd = 0;
+    for (int k = 0; k < 3; k++) {
+        d[k] = b1[k] - b0[k];
+        r[k] = x[k] - b0[k];
+        dd += d[k] * d[k];
+        rd += r[k] * d[k];
+    }
+    double t = dd > 0 ? fmin(1, fmax(0, rd / dd)) : 0;
+    double s2 = 0;
+    for (int k = 0; k < 3; k++)
+        s2 += (r[k] - t * d[k]) * (r[k] - t * d[k]);
+    return sqrt(s2);
+}
+
+/* An independent estimate of the segment distance: the distance from p(s)
+ * to the second segment is convex in s, so a scan followed by ternary
+ * search finds its minimum. */
+static double sampled_dist(const double *x)
+{
+    double best = INFINITY, bs = 0;
+    const int n = 400;
+    double p[3];
+    for (int i = 0; i <= n; i++) {
+        double s = (double)i / n;
+        for (int k = 0; k < 3; k++)
+            p[k] = x[k] + s * (x[3 + k] - x[k]);
+        double d = point_segment(p, x + 6, x + 9);
+        if (d < best) {
+            best = d;
+            bs = s;
+        }
+    }
+    double lo = fmax(0, bs - 1.0 / n), hi = fmin(1, bs + 1.0 / n);
+    for (int it = 0; it < 200; it++) {
+        double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3, p2[3];
+        for (int k = 0; k < 3; k++) {
+            p[k] = x[k] + m1 * (x[3 + k] - x[k]);
+            p2[k] = x[k] + m2 * (x[3 + k] - x[k]);
+        }
+        if (point_segment(p, x + 6, x + 9) < point_segment(p2, x + 6, x + 9))
+            hi = m2;
+        else
+            lo = m1;
+    }
+    for (int k = 0; k < 3; k++)
+        p[k] = x[k] + lo * (x[3 + k] - x[k]);
+    return fmin(best, point_segment(p, x + 6, x + 9));
+}
+
+/* Random segment pairs of several kinds, including nearly degenerate ones. */
+static void random_segments(tkt_rng *r, int kind, double x[12])
+{
+    for (int k = 0; k < 12; k++)
+        x[k] = tkt_rng_range(r, -1, 1);
+    double d[3];
+    for (int k = 0; k < 3; k++)
+        d[k] = x[3 + k] - x[k];
+    double tilt = 0.0;
+    switch (kind) {
+    case 0: /* general position */
+        return;
+    case 1: tilt = 1e-3; break;   /* nearly parallel */
+    case 2: tilt = 1e-5; break;   /* more nearly parallel */
+    case 3: tilt = 0.0; break;    /* exactly parallel */
+    case 4: /* closest point near an end of the second segment */
+        for (int k = 0; k < 3; k++)
+            x[9 + k] = x[6 + k] + 1e-4 * (x[9 + k] - x[6 + k]);
+        return;
+    default:
+        return;
+    }
+    /* second segment = first shifted, direction tilted slightly */
+    double shift[3], wob[3];
+    tkt_rng_point(r, 0.5, shift);
+    tkt_rng_point(r, 1.0, wob);
+    double len = tkt_rng_range(r, 0.3, 1.5), off = tkt_rng_range(r, -0.8, 0.8);
+    for (int k = 0; k < 3; k++) {
+        x[6 + k] = x[k] + shift[k] + off * d[k];
+        x[9 + k] = x[6 + k] + len * d[k] + tilt * wob[k];
+    }
+}
+
+START_TEST(segment_distance_matches_sampling)
+{
+    tkt_rng r = {42};
+    for (int trial = 0; trial < 400; trial++) {
+        double x[12];
+        random_segments(&r, trial % 5, x);
+        double d = seg_dist(x), ref = sampled_dist(x);
+        /* the sampled minimum is an upper bound within grid resolution */
+        ck_assert_msg(d <= ref + 1e-12, "trial %d: %.17g > sampled %.17g", trial, d, ref);
+        ck_assert_msg(ref - d < 1e-12, "trial %d: %.17g vs sampled %.17g", trial, d, ref);
+        /* the reported points are on the segments and at the distance */
+        tk_closest c;
+        tk_segment_closest(x, x + 3, x + 6, x + 9, &c);
+        ck_assert(c.s >= 0 && c.s <= 1 && c.t >= 0 && c.t <= 1);
+        double pq = 0;
+        for (int k = 0; k < 3; k++) {
+            double p = x[k] + c.s * (x[3 + k] - x[k]);
+            double q = x[6 + k] + c.t * (x[9 + k] - x[6 + k]);
+            ck_assert(fabs(p - c.p[k]) < 1e-14 && fabs(q - c.q[k]) < 1e-14);
+            pq += (c.p[k] - c.q[k]) * (c.p[k] - c.q[k]);
+        }
+        ck_assert(fabs(sqrt(pq) - c.dist) < 1e-15);
+    }
+}
+END_TEST
+
+START_TEST(segment_distance_exact_cases)
+{
+    /* crossing perpendicular segments 2 apart */
+    double a0[3] = {-1, 0, 0}, a1[3] = {1, 0, 0}, b0[3] = {0, -1, 2}, b1[3] = {0, 1, 2};
+    tk_closest c;
+    tk_segment_closest(a0, a1, b0, b1, &c);
+    ck_assert_double_eq_tol(c.dist, 2.0, 1e-15);
+    ck_assert_double_eq_tol(c.s, 0.5, 1e-15);
+    ck_assert_double_eq_tol(c.t, 0.5, 1e-15);
+    /* parallel overlapping segments: distance is the offset */
+    double p0[3] = {0, 0, 0}, p1[3] = {2, 0, 0}, q0[3] = {1, 0.5, 0}, q1[3] = {3, 0.5, 0};
+    tk_segment_closest(p0, p1, q0, q1, &c);
+    ck_assert_double_eq_tol(c.dist, 0.5, 1e-15);
+    /* collinear disjoint: gap between the ends */
+    double r0[3] = {4, 0, 0}, r1[3] = {5, 0, 0};
+    tk_segment_closest(p0, p1, r0, r1, &c);
+    ck_assert_double_eq_tol(c.dist, 2.0, 1e-15);
+    ck_assert(c.s == 1.0 && c.t == 0.0);
+    /* a degenerate segment is a point */
+    tk_segment_closest(b0, b0, a0, a1, &c);
+    ck_assert_double_eq_tol(c.dist, sqrt(5.0), 1e-15);
+}
+END_TEST
+
+START_TEST(distance_gradient_matches_finite_differences)
+{
+    tkt_rng r = {7};
+    int checked = 0;
+    for (int trial = 0; trial < 2000; trial++) {
+        double x[12];
+        random_segments(&r, trial % 5, x);
+        tk_closest c;
+        tk_segment_closest(x, x + 3, x + 6, x + 9, &c);
+        /* Equation (7) holds where the minimum is unique; exactly parallel
+         * pairs have a family of minima (and no derivative), and the
+         * distance is not differentiable where the closest point sits on an
+         * end point with a nearly flat side. */
+        if (trial % 5 == 3 || c.dist < 1e-3)
+            continue;
+        double g[12], fd[12];
+        tk_segment_distance_gradient(&c, g);
+        const double h = 1e-6;
+        for (int k = 0; k < 12; k++) {
+            double y[12];
+            memcpy(y, x, sizeof y);
+            y[k] = x[k] + h;
+            double up = seg_dist(y);
+            y[k] = x[k] - h;
+            double down = seg_dist(y);
+            fd[k] = (up - down) / (2 * h);
+        }
+        /* Skip configurations where a kink of the min-function lies within
+         * the difference stencil: one-sided differences disagree there. */
+        bool kink = false;
+        for (int k = 0; k < 12 && !kink; k++) {
+            double y[12];
+            memcpy(y, x, sizeof y);
+            y[k] = x[k] + h;
+            double up = seg_dist(y);
+            double fwd = (up - c.dist) / h;
+            y[k] = x[k] - h;
+            double back = (c.dist - seg_dist(y)) / h;
+            kink = fabs(fwd - back) > 1e-4 * (1 + fabs(fwd));
+        }
+        if (kink)
+            continue;
+        checked++;
+        ck_assert_msg(vec_reldiff(g, fd, 12) < 1e-6, "trial %d (kind %d): rel diff %g", trial,
+                      trial % 5, vec_reldiff(g, fd, 12));
+    }
+    ck_assert_int_gt(checked, 1000);
+}
+END_TEST
+
+static double minrad_at(const double *x)
+{
+    return tk_vertex_minrad(x, x + 3, x + 6);
+}
+
+START_TEST(minrad_gradient_matches_finite_differences)
+{
+    tkt_rng r = {99};
+    int checked = 0;
+    for (int trial = 0; trial < 3000; trial++) {
+        double x[9];
+        for (int k = 0; k < 9; k++)
+            x[k] = tkt_rng_range(&r, -1, 1);
+        int kind = trial % 4;
+        if (kind == 1 || kind == 2) {
+            /* nearly straight (1) or nearly reversing (2) vertex */
+            double dir[3], wob[3];
+            for (int k = 0; k < 3; k++)
+                dir[k] = x[3 + k] - x[k];
+            tkt_rng_point(&r, 1.0, wob);
+            double amount = kind == 1 ? 1e-2 : 1e-2;
+            double sign = kind == 1 ? 1.0 : -1.0;
+            double len = tkt_rng_range(&r, 0.2, 2.0);
+            for (int k = 0; k < 3; k++)
+                x[6 + k] = x[3 + k] + sign * len * dir[k] + amount * wob[k];
+        } else if (kind == 3) {
+            /* very unequal edges */
+            for (int k = 0; k < 3; k++)
+                x[k] = x[3 + k] + 1e-3 * (x[k] - x[3 + k]);
+        }
+        double g[9], fd[9];
+        double value = tk_vertex_minrad_gradient(x, x + 3, x + 6, g);
+        ck_assert(fabs(value - minrad_at(x)) <= 1e-15 * fmax(1.0, value));
+        /* minrad switches branch where the two edges are equally long: no
+         * derivative there, and FD straddling it is meaningless */
+        double la = 0, lb = 0;
+        for (int k = 0; k < 3; k++) {
+            la += (x[3 + k] - x[k]) * (x[3 + k] - x[k]);
+            lb += (x[6 + k] - x[3 + k]) * (x[6 + k] - x[3 + k]);
+        }
+        if (fabs(sqrt(la) - sqrt(lb)) < 1e-3)
+            continue;
+        /* the step must be small against the features of the function:
+         * the shorter edge, and the distance from straight or reversed */
+        double turn = tk_vertex_turning(x, x + 3, x + 6);
+        double scale = fmin(sqrt(la), sqrt(lb)) * fmin(1.0, fmin(turn, M_PI - turn));
+        const double h = 1e-4 * scale;
+        for (int k = 0; k < 9; k++) {
+            double y[9];
+            memcpy(y, x, sizeof y);
+            y[k] = x[k] + h;
+            double up = minrad_at(y);
+            y[k] = x[k] - h;
+            double down = minrad_at(y);
+            fd[k] = (up - down) / (2 * h);
+        }
+        checked++;
+        ck_assert_msg(vec_reldiff(g, fd, 9) < 1e-6, "trial %d (kind %d): rel diff %g", trial,
+                      kind, vec_reldiff(g, fd, 9));
+    }
+    ck_assert_int_gt(checked, 2500);
+}
+END_TEST
+
+START_TEST(minrad_exact_values)
+{
+    /* regular n-gon of circumradius R: minrad = R cos(pi/n) (equation 3) */
+    for (size_t n = 3; n <= 1000; n = n * 3 / 2 + 1) {
+        tk_curve *c = tkt_regular_polygon(n, 2.5);
+        size_t where;
+        double m = tk_curve_minrad(c, &where);
+        /* rounding in the vertices is amplified by about n^2 (short edges,
+         * small turning angles) */
+        double tol = 1e-14 + 4e-16 * (double)(n * n);
+        ck_assert_msg(tkt_reldiff(m, 2.5 * cos(M_PI / (double)n)) < tol, "n=%zu: %.17g", n, m);
+        ck_assert(where < n);
+        tk_curve_free(&c);
+    }
+    /* a right angle with edges 1 and 3: min(1,3) / (2 tan(pi/4)) = 1/2 */
+    double a[3] = {0, 0, 0}, v[3] = {1, 0, 0}, b[3] = {1, 3, 0};
+    ck_assert_double_eq_tol(tk_vertex_minrad(a, v, b), 0.5, 1e-15);
+    ck_assert_double_eq_tol(tk_vertex_turning(a, v, b), M_PI / 2, 1e-15);
+    /* straight and reversing vertices */
+    double s[3] = {2, 0, 0};
+    ck_assert(isinf(tk_vertex_minrad(a, v, s)));
+    ck_assert(tk_vertex_minrad(a, v, a) == 0.0);
+}
+END_TEST
+
+START_TEST(length_gradient_matches_finite_differences)
+{
+    tkt_rng r = {5};
+    size_t counts[2] = {7, 5};
+    bool closed[2] = {true, false};
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_curve_new(&c, 2, counts, closed, NULL), TK_OK);
+    for (int trial = 0; trial < 50; trial++) {
+        for (size_t i = 0; i < 3 * c->nvert; i++)
+            c->xyz[i] = tkt_rng_range(&r, -2, 2);
+        double g[36], fd[36];
+        tk_curve_length_gradient(c, g);
+        const double h = 1e-6;
+        for (size_t i = 0; i < 3 * c->nvert; i++) {
+            double keep = c->xyz[i];
+            c->xyz[i] = keep + h;
+            double up = tk_curve_length(c);
+            c->xyz[i] = keep - h;
+            double down = tk_curve_length(c);
+            c->xyz[i] = keep;
+            fd[i] = (up - down) / (2 * h);
+        }
+        ck_assert_msg(vec_reldiff(g, fd, 3 * c->nvert) < 1e-6, "trial %d", trial);
+    }
+    tk_curve_free(&c);
+}
+END_TEST
+
+START_TEST(vertex_neighbours)
+{
+    size_t counts[2] = {4, 3};
+    bool closed[2] = {true, false};
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_curve_new(&c, 2, counts, closed, NULL), TK_OK);
+    size_t p, n;
+    ck_assert(tk_curve_vertex_neighbours(c, 0, &p, &n) && p == 3 && n == 1);
+    ck_assert(tk_curve_vertex_neighbours(c, 3, &p, &n) && p == 2 && n == 0);
+    ck_assert(!tk_curve_vertex_neighbours(c, 4, &p, &n));
+    ck_assert(tk_curve_vertex_neighbours(c, 5, &p, &n) && p == 4 && n == 6);
+    ck_assert(!tk_curve_vertex_neighbours(c, 6, &p, &n));
+    tk_curve_free(&c);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("geometry");
+    TCase *tc = tcase_create("geometry");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, segment_distance_matches_sampling);
+    tcase_add_test(tc, segment_distance_exact_cases);
+    tcase_add_test(tc, distance_gradient_matches_finite_differences);
+    tcase_add_test(tc, minrad_gradient_matches_finite_differences);
+    tcase_add_test(tc, minrad_exact_values);
+    tcase_add_test(tc, length_gradient_matches_finite_differences);
+    tcase_add_test(tc, vertex_neighbours);
+    suite_add_tcase(s, tc);
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
