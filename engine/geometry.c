@@ -102,7 +102,27 @@ void tk_segment_closest(const double a0[3], const double a1[3],
     }
 
     double denom = a * e - b * b;
-    if (a > 0.0 && e > 0.0 && denom > 1e-14 * a * e) {
+    if (a > 0.0 && e > 0.0 && denom <= 1e-14 * a * e) {
+        /* Parallel: a whole family of minimising pairs when the segments
+         * overlap.  Take the middle of the overlap, which is a local
+         * minimum of the self-distance wherever any of the family is
+         * (an end of the family can sit on a vertex that is not). */
+        /* b0 and b1 project onto the first line at -c/a and (b-c)/a */
+        double lo = fmax(0.0, fmin(-c / a, (b - c) / a));
+        double hi = fmin(1.0, fmax(-c / a, (b - c) / a));
+        if (lo <= hi) {
+            double s = 0.5 * (lo + hi);
+            point_at(a0, d1, s, p);
+            double t = project(p, b0, d2, e);
+            point_at(b0, d2, t, q);
+            double dk = dist3(p, q);
+            if (dk <= best * (1.0 + 1e-12)) {
+                best = dk;
+                best_s = s;
+                best_t = t;
+            }
+        }
+    } else if (a > 0.0 && e > 0.0) {
         double s = (b * f - c * e) / denom;
         double t = (a * f - b * c) / denom;
         if (s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0) {

@@ -1,0 +1,264 @@
+/* Struts: the tree against brute force (catalogue and large resampled
+ * curves), the arc rule against its closed form, one strut per contact. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "support.h"
+#include "tk/generate.h"
+#include "tk/geometry.h"
+#include "tk/struts.h"
+#include "tk/thickness.h"
+
+static void assert_same_lists(const tk_strut_list *a, const tk_strut_list *b, const char *what)
+{
+    ck_assert_msg(a->count == b->count, "%s: tree found %zu struts, brute force %zu", what,
+                  a->count, b->count);
+    for (size_t k = 0; k < a->count; k++) {
+        const tk_strut *x = &a->items[k], *y = &b->items[k];
+        ck_assert_msg(x->comp[0] == y->comp[0] && x->edge[0] == y->edge[0] &&
+                          x->comp[1] == y->comp[1] && x->edge[1] == y->edge[1] &&
+                          x->s == y->s && x->t == y->t && x->length == y->length,
+                      "%s: strut %zu differs", what, k);
+    }
+}
+
+/* Compares tree and brute force on one curve for both arc rules, with a
+ * bound wide enough that the lists are long. */
+static size_t compare_tree_and_brute(const tk_curve *c, const char *what, bool check_shortest)
+{
+    tk_strut_finder *f = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_strut_finder_new(c, &f, &err), TK_OK);
+    double shortest;
+    ck_assert_int_eq(tk_strut_finder_shortest(f, c, &shortest, NULL, &err), TK_OK);
+    if (check_shortest) {
+        double brute = tk_struts_shortest_brute(c, NULL);
+        ck_assert_msg(shortest == brute, "%s: shortest %.17g, brute force %.17g", what,
+                      shortest, brute);
+    }
+    double tau = fmin(shortest, 2.0 * tk_curve_minrad(c, NULL));
+    size_t total = 0;
+    for (int rule = 0; rule < 2; rule++) {
+        tk_strut_list tree = {0}, brute = {0};
+        double bound = 1.25 * tau;
+        ck_assert_int_eq(tk_strut_finder_find(f, c, (tk_arc_rule)rule, tau, bound, &tree, &err),
+                         TK_OK);
+        ck_assert_int_eq(tk_struts_find_brute(c, (tk_arc_rule)rule, tau, bound, &brute, &err),
+                         TK_OK);
+        assert_same_lists(&tree, &brute, what);
+        for (size_t k = 0; k < tree.count; k++)
+            ck_assert(tree.items[k].length <= bound);
+        total += tree.count;
+        tk_strut_list_free(&tree);
+        tk_strut_list_free(&brute);
+    }
+    tk_strut_finder_free(&f);
+    return total;
+}
+
+START_TEST(tree_matches_brute_force_on_catalogue)
+{
+    size_t n;
+    char **names = tkt_catalogue_names(&n);
+    if (!names) {
+        printf("catalogue absent: tree_matches_brute_force_on_catalogue skipped\n");
+        return;
+    }
+    size_t struts = 0;
+    for (size_t i = 0; i < n; i++) {
+        tk_curve *c = tkt_catalogue_curve(names[i]);
+        struts += compare_tree_and_brute(c, names[i], true);
+        tk_curve_free(&c);
+    }
+    /* the comparison is not vacuous */
+    ck_assert_uint_gt(struts, 10 * n);
+    tkt_free_names(names, n);
+}
+END_TEST
+
+static void resampled_case(const char *name, size_t vertices)
+{
+    if (!tkt_catalogue_dir()) {
+        printf("catalogue absent: resampled %s skipped\n", name);
+        return;
+    }
+    tk_curve *c = tkt_catalogue_curve(name), *big = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_curve_resample_total(c, vertices, &big, &err), TK_OK);
+    char what[64];
+    snprintf(what, sizeof what, "%s at %zu vertices", name, vertices);
+    ck_assert_uint_gt(compare_tree_and_brute(big, what, true), 0);
+    tk_curve_free(&c);
+    tk_curve_free(&big);
+}
+
+START_TEST(tree_matches_brute_force_at_1000_vertices)
+{
+    resampled_case("3.1.vect", 1000);
+    resampled_case("6.3.2.vect", 1500);
+}
+END_TEST
+
+START_TEST(tree_matches_brute_force_at_10000_vertices)
+{
+    resampled_case("8.18.vect", 4000);
+    resampled_case("10.1.vect", 10000);
+}
+END_TEST
+
+START_TEST(tree_matches_brute_force_on_generated)
+{
+    tk_curve *c = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_generate_torus(3, 5, 1200, &c, &err), TK_OK);
+    ck_assert_uint_gt(compare_tree_and_brute(c, "T(3,5)", true), 0);
+    tk_curve_free(&c);
+    ck_assert_int_eq(tk_generate_chain(4, 300, &c, &err), TK_OK);
+    ck_assert_uint_gt(compare_tree_and_brute(c, "chain of 4", true), 0);
+    tk_curve_free(&c);
+}
+END_TEST
+
+START_TEST(admissible_pairs_of_equilateral_polygon)
+{
+    /* Theorem 3: on an equilateral polygon with edge l, pairs with fewer
+     * than pi / (2 atan(l / tau)) vertices between them (on the shorter
+     * arc) are excluded. */
+    size_t n = 40;
+    tk_curve *c = tkt_regular_polygon(n, 3.0);
+    double l = tk_curve_edge_length(c, 0, 0);
+    double taus[3] = {0.5, 1.0, 2.0};
+    for (int k = 0; k < 3; k++) {
+        double need = M_PI / (2.0 * atan(l / taus[k]));
+        for (size_t i = 0; i < n; i++)
+            for (size_t j = i + 1; j < n; j++) {
+                size_t fwd = j - i, bwd = n - fwd; /* vertices strictly between */
+                bool expect = (double)(fwd < bwd ? fwd : bwd) >= need && fwd > 1 && bwd > 1;
+                ck_assert_msg(tk_struts_pair_allowed(c, TK_ARC_ADMISSIBLE, taus[k], i, j) == expect,
+                              "tau %g edges %zu %zu", taus[k], i, j);
+            }
+    }
+    tk_curve_free(&c);
+}
+END_TEST
+
+static tk_curve *two_open(const double *a, size_t na, const double *b, size_t nb)
+{
+    size_t counts[2] = {na, nb};
+    bool closed[2] = {false, false};
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_curve_new(&c, 2, counts, closed, NULL), TK_OK);
+    for (size_t i = 0; i < 3 * na; i++)
+        c->xyz[i] = a[i];
+    for (size_t i = 0; i < 3 * nb; i++)
+        c->xyz[3 * na + i] = b[i];
+    return c;
+}
+
+START_TEST(contact_at_shared_vertex_is_one_strut)
+{
+    /* A V whose tip touches a straight line: both edges of the V have
+     * their closest point at the tip; one contact, one strut. */
+    double v[9] = {-1, 1, 0, 0, 0, 0, 1, 1, 0};
+    double line[9] = {-2, -1, 0, 0.5, -1, 0, 2, -1, 0};
+    tk_curve *c = two_open(v, 3, line, 3);
+    tk_strut_list list = {0};
+    tk_strut_finder *f = NULL;
+    ck_assert_int_eq(tk_strut_finder_new(c, &f, NULL), TK_OK);
+    ck_assert_int_eq(tk_strut_finder_find(f, c, TK_ARC_ADMISSIBLE, 1.0, 1.5, &list, NULL), TK_OK);
+    ck_assert_uint_eq(list.count, 1);
+    ck_assert_double_eq_tol(list.items[0].length, 1.0, 1e-15);
+    /* owned by the edge starting at the tip */
+    ck_assert_uint_eq(list.items[0].edge[0], 1);
+    ck_assert(list.items[0].s == 0.0);
+    tk_strut_list_free(&list);
+    tk_strut_finder_free(&f);
+    tk_curve_free(&c);
+}
+END_TEST
+
+START_TEST(vertex_that_is_not_a_local_minimum_is_no_strut)
+{
+    /* The middle vertex is at distance 1 from the line but its left edge
+     * comes closer (its free end is at distance 0.5): only that end is a
+     * local minimum of the self-distance. */
+    double v[9] = {-1, -0.5, 0, 0, 0, 0, 1, 1, 0};
+    double line[6] = {-3, -1, 0, 3, -1, 0};
+    tk_curve *c = two_open(v, 3, line, 2);
+    tk_strut_list list = {0};
+    ck_assert_int_eq(tk_struts_find_brute(c, TK_ARC_FENCHEL, 0.0, 3.0, &list, NULL), TK_OK);
+    ck_assert_uint_eq(list.count, 1);
+    ck_assert_double_eq_tol(list.items[0].length, 0.5, 1e-15);
+    ck_assert(list.items[0].edge[0] == 0 && list.items[0].s == 0.0);
+    tk_strut_list_free(&list);
+    tk_curve_free(&c);
+}
+END_TEST
+
+START_TEST(refit_follows_moved_vertices)
+{
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_chain(3, 100, &c, NULL), TK_OK);
+    tk_strut_finder *f = NULL;
+    ck_assert_int_eq(tk_strut_finder_new(c, &f, NULL), TK_OK);
+    /* move the middle ring: the tree must see it after a refit */
+    double shift[3] = {0.3, 0.1, -0.2};
+    for (size_t v = c->offset[1]; v < c->offset[2]; v++)
+        for (int k = 0; k < 3; k++)
+            c->xyz[3 * v + k] += shift[k];
+    tk_strut_finder_refit(f, c);
+    double tree, brute = tk_struts_shortest_brute(c, NULL);
+    ck_assert_int_eq(tk_strut_finder_shortest(f, c, &tree, NULL, NULL), TK_OK);
+    ck_assert(tree == brute);
+    tk_strut_finder_free(&f);
+    tk_curve_free(&c);
+}
+END_TEST
+
+START_TEST(kinks_of_a_polygon)
+{
+    /* a square of side 2: minrad = 1 at every corner (tan 45 deg = 1) */
+    size_t n = 4;
+    bool closed = true;
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_curve_new(&c, 1, &n, &closed, NULL), TK_OK);
+    double sq[12] = {0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0};
+    for (int i = 0; i < 12; i++)
+        c->xyz[i] = sq[i];
+    tk_kink *k = NULL;
+    size_t nk = 0;
+    ck_assert_int_eq(tk_kinks_find(c, 2.0 + 1e-12, &k, &nk, NULL), TK_OK);
+    ck_assert_uint_eq(nk, 4);
+    for (size_t i = 0; i < nk; i++)
+        ck_assert_double_eq_tol(k[i].minrad, 1.0, 1e-15);
+    free(k);
+    ck_assert_int_eq(tk_kinks_find(c, 2.0 - 1e-9, &k, &nk, NULL), TK_OK);
+    ck_assert_uint_eq(nk, 0);
+    free(k);
+    tk_curve_free(&c);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("struts");
+    TCase *tc = tcase_create("struts");
+    tcase_set_timeout(tc, 600);
+    tcase_add_test(tc, tree_matches_brute_force_on_catalogue);
+    tcase_add_test(tc, tree_matches_brute_force_at_1000_vertices);
+    tcase_add_test(tc, tree_matches_brute_force_at_10000_vertices);
+    tcase_add_test(tc, tree_matches_brute_force_on_generated);
+    tcase_add_test(tc, admissible_pairs_of_equilateral_polygon);
+    tcase_add_test(tc, contact_at_shared_vertex_is_one_strut);
+    tcase_add_test(tc, vertex_that_is_not_a_local_minimum_is_no_strut);
+    tcase_add_test(tc, refit_follows_moved_vertices);
+    tcase_add_test(tc, kinks_of_a_polygon);
+    suite_add_tcase(s, tc);
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}
