@@ -63,6 +63,7 @@ typedef struct query {
     tk_arc_rule rule;
     double bound;             /* report contacts of length <= bound */
     bool shortest_mode;       /* bound shrinks to the best contact found */
+    bool plain;               /* skip the local-minimum test (a lower bound) */
     tk_strut best;
     tk_strut_list *out;
     int status;
@@ -412,7 +413,7 @@ static void test_pair(query *qy, size_t i, size_t j)
     edge_closest(f, qy->c, i, j, &cl);
     if (qy->shortest_mode ? !(cl.dist < qy->bound) : !(cl.dist <= qy->bound))
         return;
-    if (!owns_contact(f, qy->c, i, j, &cl))
+    if (!qy->plain && !owns_contact(f, qy->c, i, j, &cl))
         return;
     if (qy->shortest_mode) {
         qy->bound = cl.dist;
@@ -528,12 +529,13 @@ int tk_strut_finder_find(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule
         return tk_error_set(err, TK_EINVAL, "the diameter must be positive (got %g)", tau);
     fill_prefix(f, c, rule, tau);
     size_t start = out->count;
-    query qy = {f, c, rule, bound, false, {{0}}, out, TK_OK};
+    query qy = {f, c, rule, bound, false, false, {{0}}, out, TK_OK};
     if (f->nedges > 1 && bound >= 0.0)
         visit(&qy, 0, 0);
     if (qy.status != TK_OK)
         return tk_error_set(err, qy.status, "out of memory listing struts");
-    qsort(out->items + start, out->count - start, sizeof *out->items, compare_struts);
+    if (out->count > start)
+        qsort(out->items + start, out->count - start, sizeof *out->items, compare_struts);
     return TK_OK;
 }
 
@@ -544,9 +546,36 @@ int tk_strut_finder_shortest(tk_strut_finder *f, const tk_curve *c, double *shor
     if (rc)
         return rc;
     fill_prefix(f, c, TK_ARC_FENCHEL, 0.0);
-    query qy = {f, c, TK_ARC_FENCHEL, INFINITY, true, {{0}}, NULL, TK_OK};
-    if (f->nedges > 1)
+    query qy = {f, c, TK_ARC_FENCHEL, INFINITY, true, false, {{0}}, NULL, TK_OK};
+    *shortest = INFINITY;
+    if (f->nedges < 2)
+        return TK_OK;
+    /* Branch and bound needs a good bound early: with none, every node pair
+     * closer than the first contact found is opened, and on a finely
+     * sampled curve that is most of them (pairs near a contact are close
+     * but not local minima, so they never tighten the bound).  First the
+     * plain minimum over the same pairs, without the local-minimum test:
+     * every pair tightens it, so it comes fast, and it is a lower bound of
+     * the answer (usually equal to it).  Then search for local minima in a
+     * radius just above it, widening slowly until one turns up. */
+    qy.plain = true;
+    visit(&qy, 0, 0);
+    double lower = qy.bound;
+    qy.plain = false;
+    const tree_node *root = &f->nodes[0];
+    double diagonal = 0.0;
+    for (int k = 0; k < 3; k++)
+        diagonal += (root->hi[k] - root->lo[k]) * (root->hi[k] - root->lo[k]);
+    diagonal = sqrt(diagonal);
+    double radius = isfinite(lower) ? lower * (1.0 + 1e-9) + 1e-300 : INFINITY;
+    for (;;) {
+        bool last = !(radius <= 2.0 * diagonal);
+        qy.bound = last ? INFINITY : radius;
         visit(&qy, 0, 0);
+        if (qy.bound < radius || last)
+            break;
+        radius *= 1.05;
+    }
     *shortest = qy.bound;
     if (where)
         *where = qy.best;
@@ -564,14 +593,15 @@ int tk_struts_find_brute(const tk_curve *c, tk_arc_rule rule, double tau, double
         return rc;
     fill_prefix(f, c, rule, tau);
     size_t start = out->count;
-    query qy = {f, c, rule, bound, false, {{0}}, out, TK_OK};
+    query qy = {f, c, rule, bound, false, false, {{0}}, out, TK_OK};
     for (size_t i = 0; i < f->nedges && qy.status == TK_OK; i++)
         for (size_t j = i + 1; j < f->nedges; j++)
             test_pair(&qy, i, j);
     tk_strut_finder_free(&f);
     if (qy.status != TK_OK)
         return tk_error_set(err, qy.status, "out of memory listing struts");
-    qsort(out->items + start, out->count - start, sizeof *out->items, compare_struts);
+    if (out->count > start)
+        qsort(out->items + start, out->count - start, sizeof *out->items, compare_struts);
     return TK_OK;
 }
 
@@ -581,7 +611,7 @@ double tk_struts_shortest_brute(const tk_curve *c, tk_strut *where)
     if (tk_strut_finder_new(c, &f, NULL) != TK_OK)
         return NAN;
     fill_prefix(f, c, TK_ARC_FENCHEL, 0.0);
-    query qy = {f, c, TK_ARC_FENCHEL, INFINITY, true, {{0}}, NULL, TK_OK};
+    query qy = {f, c, TK_ARC_FENCHEL, INFINITY, true, false, {{0}}, NULL, TK_OK};
     for (size_t i = 0; i < f->nedges; i++)
         for (size_t j = i + 1; j < f->nedges; j++)
             test_pair(&qy, i, j);

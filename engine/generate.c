@@ -1,0 +1,284 @@
+/* tightknot: example knots and links (include/tk/generate.h).
+ *
+ * Every generator samples a closed parametrised curve at equal parameter
+ * steps.  Angles are evaluated by unit_circle(), which reduces k/n to the
+ * first quadrant in integers, so that points at multiples of pi/2 come out
+ * exact (cos(M_PI) is -1 but sin(M_PI) is 1.2e-16): the Hopf link's vertex at
+ * the other circle's centre is then exactly there, and the polygons keep the
+ * symmetries of their curves bit for bit.
+ */
+#include "tk/generate.h"
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+/* Counts beyond which a generator refuses: the VECT reader's default
+ * limits (TK_VECT_LIMITS_INIT), so that every generated curve reads back. */
+#define MAX_TOTAL_VERTICES ((size_t)10000000)
+#define MAX_COMPONENTS ((size_t)10000)
+
+/* (cos, sin) of 2 pi k / n, exact at multiples of pi/2. */
+static void unit_circle(size_t k, size_t n, double *c, double *s)
+{
+    k %= n;
+    /* 4k = quadrant * n + r with 0 <= r < n: the angle is
+     * quadrant * pi/2 + (pi/2) r / n.  In 64 bits 4k cannot overflow
+     * (n is a vertex count <= 10^7 or a torus q < 2^31). */
+    uint64_t four_k = 4 * (uint64_t)k;
+    uint64_t quadrant = four_k / n;
+    uint64_t r = four_k % n;
+    double a = (M_PI / 2.0) * (double)r / (double)n;
+    double c0 = r == 0 ? 1.0 : cos(a);
+    double s0 = r == 0 ? 0.0 : sin(a);
+    switch (quadrant) {
+    case 0: *c = c0; *s = s0; break;
+    case 1: *c = -s0; *s = c0; break;
+    case 2: *c = -c0; *s = -s0; break;
+    default: *c = s0; *s = -c0; break;
+    }
+    /* No negative zeros in the output (x + 0.0 is +0 for x = -0). */
+    *c += 0.0;
+    *s += 0.0;
+}
+
+/* Checks a per-component count (0 = default) against the shared rules and
+ * the total against the limit; *n receives the count to use. */
+static int check_counts(size_t vertices, size_t default_vertices,
+                        size_t ncomp, size_t *n, tk_error *err)
+{
+    size_t v = vertices ? vertices : default_vertices;
+    if (ncomp > MAX_COMPONENTS)
+        return tk_error_set(err, TK_ELIMIT, "%zu components exceed the limit of %zu",
+                            ncomp, MAX_COMPONENTS);
+    if (v < 3)
+        return tk_error_set(err, TK_EINVAL,
+                            "a closed component needs at least 3 vertices (asked for %zu)",
+                            v);
+    if (v > MAX_TOTAL_VERTICES || ncomp > MAX_TOTAL_VERTICES / v)
+        return tk_error_set(err, TK_ELIMIT,
+                            "%zu components of %zu vertices exceed the limit of %zu vertices",
+                            ncomp, v, MAX_TOTAL_VERTICES);
+    *n = v;
+    return TK_OK;
+}
+
+/* A curve of ncomp closed components of n vertices each. */
+static int new_closed(size_t ncomp, size_t n, tk_curve **out, tk_error *err)
+{
+    size_t *counts = malloc(ncomp * sizeof *counts);
+    bool *closed = malloc(ncomp * sizeof *closed);
+    int rc;
+    if (!counts || !closed) {
+        rc = tk_error_set(err, TK_ENOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < ncomp; i++) {
+        counts[i] = n;
+        closed[i] = true;
+    }
+    rc = tk_curve_new(out, ncomp, counts, closed, err);
+done:
+    free(counts);
+    free(closed);
+    return rc;
+}
+
+static size_t gcd_size(size_t a, size_t b)
+{
+    while (b) {
+        size_t t = a % b;
+        a = b;
+        b = t;
+    }
+    return a;
+}
+
+/* T(p, q): with g = gcd(p, q), p' = p/g, q' = q/g, one strand is
+ *     alpha = p' t, beta = q' t, t in [0, 2 pi),
+ * on the torus ((2 + cos beta) cos alpha, (2 + cos beta) sin alpha,
+ * sin beta).  The strand is the level set q' alpha - p' beta = 0 (mod 2 pi)
+ * of the torus; strand k is the level 2 pi k / g, obtained by turning
+ * strand 0 by 2 pi k / q about the z axis (q' * 2 pi k / q = 2 pi k / g).
+ * (Turning by 2 pi k / p instead would give the level 2 pi k q' / (g p'),
+ * which coincides with strand 0 for T(2, 4).)  The g levels are evenly
+ * spaced, so the strands are disjoint, and the torus map is injective
+ * (major radius 2 > minor radius 1), so each strand is embedded.
+ *
+ * Sampling needs two things.  Every step must advance both angles by less
+ * than pi, or the polygon loses its winding (T(2,3) sampled at 3 vertices
+ * is a flat triangle): n >= 2 max(p', q') + 1.  And the chords must stay
+ * close to the curve compared with the gap between neighbouring strands:
+ * in the flat (alpha, beta) square the strands are parallel lines 2 pi /
+ * (g S) apart, S = |(p', q')|, a step is 2 pi S / n long and its chord
+ * sags by about step^2 / 8 (the tube has radius 1); sag < gap / 2 gives
+ * n > sqrt(pi g S^3 / 2).  We ask for n >= 2 sqrt(g S^3), which a brute
+ * force check of every edge pair found embedded, with strands at least
+ * 0.37 of that gap apart, for all p, q <= 60 (with sqrt(g S^3) alone
+ * T(20, 7) intersects itself). */
+static size_t torus_min_vertices(size_t g, size_t pp, size_t qq)
+{
+    size_t wind = pp > qq ? pp : qq;
+    double s2 = (double)pp * (double)pp + (double)qq * (double)qq;
+    double need = ceil(2.0 * sqrt((double)g * s2 * sqrt(s2)));
+    double lo = 2.0 * (double)wind + 1.0;
+    if (need < lo)
+        need = lo;
+    /* Beyond the limit the caller refuses anyway; keep the value finite. */
+    if (need > (double)MAX_TOTAL_VERTICES)
+        return MAX_TOTAL_VERTICES + 1;
+    return (size_t)need;
+}
+
+int tk_generate_torus(int p, int q, size_t vertices, tk_curve **out,
+                      tk_error *err)
+{
+    *out = NULL;
+    if (p < 1 || q < 1)
+        return tk_error_set(err, TK_EINVAL,
+                            "torus T(%d, %d): p and q must be at least 1", p, q);
+    size_t g = gcd_size((size_t)p, (size_t)q);
+    size_t pp = (size_t)p / g, qq = (size_t)q / g;
+    size_t wind = pp > qq ? pp : qq;
+    size_t least = torus_min_vertices(g, pp, qq);
+    /* About 40 vertices per turn of the faster angle (edges of about a
+     * quarter of the tube radius on this torus), never below 60, and with
+     * room to spare over the minimum. */
+    size_t dflt = wind > MAX_TOTAL_VERTICES / 40 ? MAX_TOTAL_VERTICES + 1 : 40 * wind;
+    if (dflt < 60)
+        dflt = 60;
+    if (least <= MAX_TOTAL_VERTICES && dflt < 2 * least)
+        dflt = 2 * least;
+    size_t n;
+    int rc = check_counts(vertices, dflt, g, &n, err);
+    if (rc)
+        return rc;
+    if (least > MAX_TOTAL_VERTICES)
+        return tk_error_set(err, TK_ELIMIT,
+                            "torus T(%d, %d) needs more vertices than the limit of %zu",
+                            p, q, MAX_TOTAL_VERTICES);
+    if (n < least)
+        return tk_error_set(err, TK_EINVAL,
+                            "torus T(%d, %d) needs at least %zu vertices per component to be embedded (asked for %zu)",
+                            p, q, least, n);
+    rc = new_closed(g, n, out, err);
+    if (rc)
+        return rc;
+    tk_curve *c = *out;
+    for (size_t k = 0; k < g; k++) {
+        double ck, sk;
+        unit_circle(k, (size_t)q, &ck, &sk);
+        for (size_t i = 0; i < n; i++) {
+            double ca, sa, cb, sb;
+            /* p' i and q' i modulo n, in 64 bits (n <= 10^7, p', q' < 2^31). */
+            unit_circle((size_t)((uint64_t)pp * i % n), n, &ca, &sa);
+            unit_circle((size_t)((uint64_t)qq * i % n), n, &cb, &sb);
+            double r = 2.0 + cb;
+            double x = r * ca, y = r * sa;
+            double *v = tk_curve_vertex(c, c->offset[k] + i);
+            v[0] = ck * x - sk * y + 0.0;
+            v[1] = sk * x + ck * y + 0.0;
+            v[2] = sb;
+        }
+    }
+    return TK_OK;
+}
+
+/* Circle A: radius 1 about the origin in the xy plane, vertex 0 at (1,0,0).
+ * Circle B: radius 1 about (1,0,0) in the xz plane, vertex 0 at (2,0,0) and
+ * vertex n/2 at the origin, which needs n even; both get the same (even)
+ * count so that the link keeps its symmetry swapping the circles. */
+int tk_generate_hopf(size_t vertices, tk_curve **out, tk_error *err)
+{
+    *out = NULL;
+    size_t n;
+    int rc = check_counts(vertices, 64, 2, &n, err);
+    if (rc)
+        return rc;
+    n += n % 2;
+    rc = new_closed(2, n, out, err);
+    if (rc)
+        return rc;
+    tk_curve *c = *out;
+    for (size_t i = 0; i < n; i++) {
+        double co, si;
+        unit_circle(i, n, &co, &si);
+        double *a = tk_curve_vertex(c, i);
+        a[0] = co;
+        a[1] = si;
+        a[2] = 0.0;
+        double *b = tk_curve_vertex(c, n + i);
+        b[0] = 1.0 + co;
+        b[1] = 0.0;
+        b[2] = si;
+    }
+    return TK_OK;
+}
+
+/* The ellipses x^2/4 + y^2 = 1 (z = 0), y^2/4 + z^2 = 1 (x = 0) and
+ * z^2/4 + x^2 = 1 (y = 0), each turned a third of the way round the
+ * diagonal from the previous one.  Each pair is unlinked: the second meets
+ * the plane of the first at (0, +-2, 0), both outside the first; the
+ * three together are the Borromean rings.  Distinct components stay at
+ * least sqrt(2/3) apart. */
+int tk_generate_borromean(size_t vertices, tk_curve **out, tk_error *err)
+{
+    *out = NULL;
+    size_t n;
+    int rc = check_counts(vertices, 96, 3, &n, err);
+    if (rc)
+        return rc;
+    rc = new_closed(3, n, out, err);
+    if (rc)
+        return rc;
+    tk_curve *c = *out;
+    for (size_t i = 0; i < n; i++) {
+        double co, si;
+        unit_circle(i, n, &co, &si);
+        double *e0 = tk_curve_vertex(c, i);
+        double *e1 = tk_curve_vertex(c, n + i);
+        double *e2 = tk_curve_vertex(c, 2 * n + i);
+        e0[0] = 2.0 * co; e0[1] = si;       e0[2] = 0.0;
+        e1[0] = 0.0;      e1[1] = 2.0 * co; e1[2] = si;
+        e2[0] = si;       e2[1] = 0.0;      e2[2] = 2.0 * co;
+    }
+    return TK_OK;
+}
+
+/* Ring i: radius 1 about (1.5 i, 0, 0), in the xy plane for even i and the
+ * xz plane for odd i.  Ring i + 1 crosses the plane of ring i at distance
+ * 0.5 (inside) and 2.5 (outside) from its centre, so neighbours link once;
+ * rings two apart share a plane with centres 3 apart and do not touch. */
+int tk_generate_chain(size_t k, size_t vertices, tk_curve **out,
+                      tk_error *err)
+{
+    *out = NULL;
+    if (k < 1)
+        return tk_error_set(err, TK_EINVAL, "a chain needs at least 1 ring");
+    size_t n;
+    int rc = check_counts(vertices, 64, k, &n, err);
+    if (rc)
+        return rc;
+    /* Triangles do not link: ring i + 1's edge through the plane of ring i
+     * would pass through ring i's vertex at (1.5 i + 1, 0, 0). */
+    if (n < 4)
+        return tk_error_set(err, TK_EINVAL,
+                            "a chain needs at least 4 vertices per ring (asked for %zu)", n);
+    rc = new_closed(k, n, out, err);
+    if (rc)
+        return rc;
+    tk_curve *c = *out;
+    for (size_t r = 0; r < k; r++) {
+        double centre = 1.5 * (double)r;
+        for (size_t i = 0; i < n; i++) {
+            double co, si;
+            unit_circle(i, n, &co, &si);
+            double *v = tk_curve_vertex(c, c->offset[r] + i);
+            v[0] = centre + co;
+            v[1] = r % 2 == 0 ? si : 0.0;
+            v[2] = r % 2 == 0 ? 0.0 : si;
+        }
+    }
+    return TK_OK;
+}

@@ -1,0 +1,712 @@
+/* tightknot: the command-line program.
+ *
+ *   tightknot info [--json] [--tolerance EPS] FILE...
+ *   tightknot struts [--json] [--tolerance EPS] FILE
+ *   tightknot generate torus P Q | hopf | borromean | chain K [--vertices N]
+ *
+ * One static function per subcommand; options are parsed by one shared
+ * helper that knows which options each subcommand accepts.  Options may
+ * come before or after the other arguments ("generate torus 2 3
+ * --vertices 90"), "--" ends them, "-" as a file is standard input.
+ *
+ * Exit status: 0 success, 1 usage error (the message names the option or
+ * argument), 2 bad input (the engine's message, "FILE:LINE: what").
+ */
+#include <errno.h>
+#include <jansson.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tk/curve.h"
+#include "tk/error.h"
+#include "tk/generate.h"
+#include "tk/struts.h"
+#include "tk/thickness.h"
+#include "tk/vect.h"
+
+enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_INPUT = 2 };
+
+#define DEFAULT_TOLERANCE 1e-4
+
+/* ------------------------------------------------------------ help texts */
+
+static const char main_help[] =
+    "usage: tightknot COMMAND [OPTIONS] [ARGUMENTS]\n"
+    "\n"
+    "Measures and makes polygonal knots and links in Geomview VECT format.\n"
+    "\n"
+    "Commands:\n"
+    "  info       length, thickness, ropelength and contacts of VECT files\n"
+    "  struts     the struts (self-contacts) and kinks of one VECT file\n"
+    "  generate   write an example knot or link (torus, Hopf, Borromean,\n"
+    "             chain) as VECT on standard output\n"
+    "  help       show the help of a command: tightknot help info\n"
+    "\n"
+    "Options:\n"
+    "  -h, --help   show this help; 'tightknot COMMAND --help' shows a command's\n"
+    "\n"
+    "Conventions: the thickness is the diameter of the thickest embedded tube\n"
+    "(min of 2 * minrad and the shortest doubly critical self-distance);\n"
+    "ropelength = length / tube radius = 2 * length / thickness, the convention\n"
+    "of the published tables (tight trefoil about 32.74, tight Hopf link 8 pi).\n"
+    "\n"
+    "Exit status: 0 success, 1 usage error, 2 bad input.\n"
+    "\n"
+    "Example:\n"
+    "  tightknot generate torus 2 3 > trefoil.vect && tightknot info trefoil.vect\n";
+
+static const char info_help[] =
+    "usage: tightknot info [--json] [--tolerance EPS] FILE...\n"
+    "\n"
+    "Measures each VECT file (\"-\" is standard input): its number of\n"
+    "components and vertices, length, thickness, minrad, ropelength, and how\n"
+    "many struts and kinks are active, that is within a relative tolerance of\n"
+    "the thickness.\n"
+    "\n"
+    "  thickness   tube diameter: min(2 * minrad, shortest doubly critical\n"
+    "              self-distance)\n"
+    "  minrad      smallest polygonal radius of curvature,\n"
+    "              min(|e_{i-1}|, |e_i|) / (2 tan(theta_i / 2))\n"
+    "  ropelength  length / tube radius = 2 * length / thickness\n"
+    "  struts      admissible edge pairs at distance <= thickness * (1 + EPS)\n"
+    "  kinks       vertices with 2 * minrad <= thickness * (1 + EPS)\n"
+    "\n"
+    "Options:\n"
+    "  --json            one JSON object per file and line, with the names\n"
+    "                    file, components, vertices, length, thickness, minrad,\n"
+    "                    ropelength, struts, kinks (full precision; null for a\n"
+    "                    value that is not finite)\n"
+    "  --tolerance EPS   relative tolerance for struts and kinks, >= 0\n"
+    "                    (default 1e-4)\n"
+    "  -h, --help        show this help\n"
+    "\n"
+    "Every file is processed; the exit status is 2 if any could not be read\n"
+    "(the message, on standard error, is \"tightknot: FILE:LINE: what\"), 1 on\n"
+    "a usage error, 0 otherwise.\n"
+    "\n"
+    "Example:\n"
+    "  tightknot info --json ../shared/catalogue/3.1.vect\n";
+
+static const char struts_help[] =
+    "usage: tightknot struts [--json] [--tolerance EPS] FILE\n"
+    "\n"
+    "Lists the active contacts of one VECT file (\"-\" is standard input):\n"
+    "every strut (an admissible pair of edges at distance within\n"
+    "thickness * (1 + EPS), a local minimum of the self-distance) and every\n"
+    "kink (a vertex where 2 * minrad is within the same bound), with the\n"
+    "thickness (tube diameter) they are measured against.\n"
+    "\n"
+    "A strut gives its two edges as component:edge pairs (edge k of a\n"
+    "component runs from its vertex k to vertex k+1, counting from 0), the\n"
+    "parameters s and t in [0, 1] of its end points along them, the end\n"
+    "points p and q, and its length |p - q|.  A kink gives its component,\n"
+    "vertex and minrad.\n"
+    "\n"
+    "Options:\n"
+    "  --json            one JSON object: {\"file\", \"thickness\",\n"
+    "                    \"struts\": [{\"edges\": [[c, i], [c, j]], \"s\", \"t\",\n"
+    "                    \"p\": [x, y, z], \"q\": [x, y, z], \"length\"}],\n"
+    "                    \"kinks\": [{\"comp\", \"vertex\", \"minrad\"}]}\n"
+    "  --tolerance EPS   relative tolerance, >= 0 (default 1e-4)\n"
+    "  -h, --help        show this help\n"
+    "\n"
+    "Conventions: thickness = tube diameter; ropelength = length / tube\n"
+    "radius = 2 * length / thickness.  Exit status: 0 success, 1 usage\n"
+    "error, 2 bad input.\n"
+    "\n"
+    "Example:\n"
+    "  tightknot struts --tolerance 1e-3 ../shared/catalogue/3_1_328.vect\n";
+
+static const char generate_help[] =
+    "usage: tightknot generate SHAPE [--vertices N]\n"
+    "\n"
+    "Writes an example knot or link as VECT (full precision) on standard\n"
+    "output.  Every component is a closed polygon with vertices evenly\n"
+    "spaced in its parameter.  SHAPE is one of:\n"
+    "\n"
+    "  torus P Q   the torus knot or link T(P, Q), P, Q >= 1, on the torus of\n"
+    "              radii 2 and 1; gcd(P, Q) components (T(2,3) is the\n"
+    "              trefoil, T(2,4) a two-component link)\n"
+    "  hopf        the Hopf link: two circles of radius 1 in perpendicular\n"
+    "              planes, each through the other's centre (tight at\n"
+    "              thickness 1: ropelength 8 pi); N is rounded up to even\n"
+    "  borromean   the Borromean rings: three perpendicular ellipses with\n"
+    "              semi-axes 2 and 1\n"
+    "  chain K     K >= 1 rings of radius 1, centres 1.5 apart on the x axis,\n"
+    "              in alternating planes, each linked with its neighbours\n"
+    "\n"
+    "Options:\n"
+    "  --vertices N   vertices per component (default: torus about 40 per\n"
+    "                 turn, at least 60; hopf 64; borromean 96; chain 64).\n"
+    "                 Too few to keep the polygon embedded is refused.\n"
+    "  -h, --help     show this help\n"
+    "\n"
+    "Conventions (as in 'tightknot info'): thickness is the tube diameter,\n"
+    "ropelength = length / tube radius = 2 * length / thickness; so the\n"
+    "generated Hopf link has thickness near 1 and ropelength near 8 pi.\n"
+    "\n"
+    "Exit status: 0 success, 1 usage error (including a shape argument out\n"
+    "of range), 2 failure writing the output.\n"
+    "\n"
+    "Example:\n"
+    "  tightknot generate torus 2 3 --vertices 150 > trefoil.vect\n";
+
+/* -------------------------------------------------------- option parsing */
+
+enum {
+    OPT_JSON = 1u << 0,
+    OPT_TOLERANCE = 1u << 1,
+    OPT_VERTICES = 1u << 2
+};
+
+typedef struct option_spec {
+    const char *name;
+    unsigned flag;
+    bool takes_value;
+} option_spec;
+
+static const option_spec option_specs[] = {
+    {"json", OPT_JSON, false},
+    {"tolerance", OPT_TOLERANCE, true},
+    {"vertices", OPT_VERTICES, true},
+};
+
+typedef struct cli_args {
+    bool help;
+    bool json;
+    double tolerance;
+    size_t vertices; /* 0: the generator's default */
+    int npos;        /* the arguments that are not options, in order */
+    char **pos;
+} cli_args;
+
+/* Prints "tightknot CMD: message" and a pointer to the help on stderr;
+ * returns EXIT_USAGE. */
+static int usage_error(const char *cmd, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static int usage_error(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "tightknot%s%s: ", cmd ? " " : "", cmd ? cmd : "");
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\nTry 'tightknot%s%s --help'.\n", cmd ? " " : "", cmd ? cmd : "");
+    return EXIT_USAGE;
+}
+
+static int parse_real(const char *cmd, const char *what, const char *text, double *out)
+{
+    char *end = NULL;
+    errno = 0;
+    double x = strtod(text, &end);
+    if (end == text || *end != '\0' || errno == ERANGE || !isfinite(x))
+        return usage_error(cmd, "%s: '%s' is not a finite number", what, text);
+    *out = x;
+    return EXIT_OK;
+}
+
+static int parse_integer(const char *cmd, const char *what, const char *text,
+                         long long lo, long long hi, long long *out)
+{
+    char *end = NULL;
+    errno = 0;
+    long long x = strtoll(text, &end, 10);
+    if (end == text || *end != '\0' || errno == ERANGE || x < lo || x > hi)
+        return usage_error(cmd, "%s: '%s' is not an integer from %lld to %lld", what,
+                           text, lo, hi);
+    *out = x;
+    return EXIT_OK;
+}
+
+/* Options start with '-', except "-" alone (standard input) and negative
+ * numbers, which are arguments ("torus -1 3" then fails on its value, not
+ * as an unknown option). */
+static bool looks_like_option(const char *arg)
+{
+    if (arg[0] != '-' || arg[1] == '\0')
+        return false;
+    return !((arg[1] >= '0' && arg[1] <= '9') || arg[1] == '.');
+}
+
+/* Sets one option from its text value. */
+static int apply_option(const char *cmd, unsigned flag, const char *value, cli_args *a)
+{
+    switch (flag) {
+    case OPT_JSON:
+        a->json = true;
+        return EXIT_OK;
+    case OPT_TOLERANCE: {
+        double eps = 0.0;
+        if (parse_real(cmd, "--tolerance", value, &eps))
+            return EXIT_USAGE;
+        if (eps < 0.0)
+            return usage_error(cmd, "--tolerance: '%s' is negative", value);
+        a->tolerance = eps;
+        return EXIT_OK;
+    }
+    case OPT_VERTICES: {
+        long long n = 0;
+        if (parse_integer(cmd, "--vertices", value, 1, LLONG_MAX, &n))
+            return EXIT_USAGE;
+        a->vertices = (unsigned long long)n > SIZE_MAX ? SIZE_MAX : (size_t)n;
+        return EXIT_OK;
+    }
+    default:
+        return usage_error(cmd, "internal error: option %u", flag);
+    }
+}
+
+/* Parses argv[0..argc) of a subcommand, accepting the options in `allowed`
+ * (and -h/--help).  The other arguments are gathered, in order, at the
+ * front of argv itself (a->pos = argv), which is safe because a kept
+ * argument never moves to a later slot than the one it was read from. */
+static int parse_args(const char *cmd, int argc, char **argv, unsigned allowed,
+                      cli_args *a)
+{
+    a->help = false;
+    a->json = false;
+    a->tolerance = DEFAULT_TOLERANCE;
+    a->vertices = 0;
+    a->npos = 0;
+    a->pos = argv;
+    bool options_done = false;
+    for (int i = 0; i < argc; i++) {
+        char *arg = argv[i];
+        if (options_done || !looks_like_option(arg)) {
+            argv[a->npos++] = arg;
+            continue;
+        }
+        if (strcmp(arg, "--") == 0) {
+            options_done = true;
+            continue;
+        }
+        if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
+            a->help = true;
+            continue;
+        }
+        const option_spec *spec = NULL;
+        const char *eq = NULL;
+        if (arg[1] == '-') {
+            const char *name = arg + 2;
+            eq = strchr(name, '=');
+            size_t len = eq ? (size_t)(eq - name) : strlen(name);
+            for (size_t k = 0; k < sizeof option_specs / sizeof option_specs[0]; k++)
+                if ((option_specs[k].flag & allowed) && strlen(option_specs[k].name) == len &&
+                    strncmp(option_specs[k].name, name, len) == 0)
+                    spec = &option_specs[k];
+        }
+        if (!spec)
+            return usage_error(cmd, "unknown option '%s'", arg);
+        const char *value = NULL;
+        if (spec->takes_value) {
+            if (eq)
+                value = eq + 1;
+            else if (i + 1 < argc)
+                value = argv[++i];
+            else
+                return usage_error(cmd, "option --%s needs a value", spec->name);
+        } else if (eq) {
+            return usage_error(cmd, "option --%s takes no value", spec->name);
+        }
+        if (apply_option(cmd, spec->flag, value, a))
+            return EXIT_USAGE;
+    }
+    return EXIT_OK;
+}
+
+/* ---------------------------------------------------------------- output */
+
+/* The path the engine reads for a command-line file name. */
+static const char *input_path(const char *name)
+{
+    return strcmp(name, "-") == 0 ? "/dev/stdin" : name;
+}
+
+/* A JSON number, or null for inf/nan (JSON has no such numbers). */
+static json_t *json_number(double x)
+{
+    return isfinite(x) ? json_real(x) : json_null();
+}
+
+/* A JSON string; a name that is not UTF-8 keeps its ASCII bytes and shows
+ * '?' for the others, since JSON text must be Unicode. */
+static json_t *json_name(const char *s)
+{
+    json_t *j = json_string(s);
+    if (j)
+        return j;
+    char *copy = strdup(s);
+    if (!copy)
+        return NULL;
+    for (char *p = copy; *p; p++)
+        if ((unsigned char)*p >= 0x80)
+            *p = '?';
+    j = json_string(copy);
+    free(copy);
+    return j;
+}
+
+static json_t *json_point(const double x[3])
+{
+    json_t *a = json_array();
+    for (int k = 0; k < 3; k++)
+        json_array_append_new(a, json_number(x[k]));
+    return a;
+}
+
+/* Prints a JSON value on one line, numbers with 17 significant digits so
+ * that they read back as the same doubles.  Takes the reference. */
+static int print_json(json_t *value)
+{
+    char *text = value ? json_dumps(value, JSON_COMPACT | JSON_PRESERVE_ORDER |
+                                               JSON_REAL_PRECISION(17))
+                       : NULL;
+    json_decref(value);
+    if (!text) {
+        fprintf(stderr, "tightknot: out of memory making JSON\n");
+        return EXIT_INPUT;
+    }
+    puts(text);
+    free(text);
+    return EXIT_OK;
+}
+
+/* Prints an engine failure: the message names the file (and the line,
+ * for parse errors) when it comes from the reader; otherwise prefix it. */
+static void report(const char *file, const tk_error *err)
+{
+    if (file)
+        fprintf(stderr, "tightknot: %s: %s\n", file, err->message);
+    else
+        fprintf(stderr, "tightknot: %s\n", err->message);
+}
+
+/* Reads and measures one file, with its contacts.  On failure the message
+ * is printed and EXIT_INPUT returned. */
+static int load_and_measure(const char *name, double tolerance, tk_curve **curve,
+                            tk_measure *m, tk_strut_list *struts, tk_kink **kinks,
+                            size_t *nkinks)
+{
+    tk_error err;
+    tk_error_clear(&err);
+    *kinks = NULL;
+    *nkinks = 0;
+    if (tk_vect_read_file(input_path(name), NULL, curve, &err) != TK_OK) {
+        report(NULL, &err);
+        return EXIT_INPUT;
+    }
+    if (tk_thickness_contacts(*curve, tolerance, m, struts, kinks, nkinks, &err) != TK_OK) {
+        report(name, &err);
+        tk_curve_free(curve);
+        return EXIT_INPUT;
+    }
+    return EXIT_OK;
+}
+
+/* ------------------------------------------------------------- commands */
+
+static void print_info_header(int width)
+{
+    printf("%-*s %5s %9s %15s %15s %15s %15s %7s %6s\n", width, "file", "comps",
+           "vertices", "length", "thickness", "minrad", "ropelength", "struts", "kinks");
+}
+
+/* Measures one file and prints its line; the table's header goes out
+ * with the first line, so that a run where every file fails prints none. */
+static int info_one(const char *name, const cli_args *a, int width, bool *header_done)
+{
+    tk_curve *c = NULL;
+    tk_measure m;
+    tk_strut_list struts = {NULL, 0, 0};
+    tk_kink *kinks = NULL;
+    size_t nkinks = 0;
+    int status = load_and_measure(name, a->tolerance, &c, &m, &struts, &kinks, &nkinks);
+    if (status)
+        return status;
+    if (a->json) {
+        json_t *o = json_object();
+        json_object_set_new(o, "file", json_name(name));
+        json_object_set_new(o, "components", json_integer((json_int_t)c->ncomp));
+        json_object_set_new(o, "vertices", json_integer((json_int_t)c->nvert));
+        json_object_set_new(o, "length", json_number(m.length));
+        json_object_set_new(o, "thickness", json_number(m.thickness));
+        json_object_set_new(o, "minrad", json_number(m.minrad));
+        json_object_set_new(o, "ropelength", json_number(m.ropelength));
+        json_object_set_new(o, "struts", json_integer((json_int_t)struts.count));
+        json_object_set_new(o, "kinks", json_integer((json_int_t)nkinks));
+        status = print_json(o);
+    } else {
+        if (!*header_done)
+            print_info_header(width);
+        *header_done = true;
+        printf("%-*s %5zu %9zu %15.9g %15.9g %15.9g %15.9g %7zu %6zu\n", width, name,
+               c->ncomp, c->nvert, m.length, m.thickness, m.minrad, m.ropelength,
+               struts.count, nkinks);
+    }
+    tk_strut_list_free(&struts);
+    free(kinks);
+    tk_curve_free(&c);
+    return status;
+}
+
+static int cmd_info(int argc, char **argv)
+{
+    cli_args a;
+    if (parse_args("info", argc, argv, OPT_JSON | OPT_TOLERANCE, &a))
+        return EXIT_USAGE;
+    if (a.help) {
+        fputs(info_help, stdout);
+        return EXIT_OK;
+    }
+    if (a.npos == 0)
+        return usage_error("info", "no FILE given");
+    int width = 4;
+    for (int i = 0; i < a.npos; i++) {
+        size_t len = strlen(a.pos[i]);
+        if (len > (size_t)width)
+            width = len > 60 ? 60 : (int)len;
+    }
+    int status = EXIT_OK;
+    bool header_done = false;
+    for (int i = 0; i < a.npos; i++) {
+        int one = info_one(a.pos[i], &a, width, &header_done);
+        if (one > status)
+            status = one;
+        /* Results show up as they come, in order with the messages. */
+        fflush(stdout);
+    }
+    return status;
+}
+
+static void print_struts_text(const char *name, const tk_measure *m, const tk_strut_list *s,
+                              const tk_kink *kinks, size_t nkinks, double tolerance)
+{
+    printf("file        %s\n", name);
+    printf("thickness   %.17g\n", m->thickness);
+    printf("length      %.17g\n", m->length);
+    printf("ropelength  %.17g\n", m->ropelength);
+    printf("bound       %.17g (thickness * (1 + %g))\n", m->thickness * (1.0 + tolerance),
+           tolerance);
+    printf("\n%zu strut%s\n", s->count, s->count == 1 ? "" : "s");
+    if (s->count > 0)
+        printf("%6s %12s %12s %10s %10s %36s %36s %12s\n", "#", "edge", "edge", "s", "t",
+               "p", "q", "length");
+    for (size_t i = 0; i < s->count; i++) {
+        const tk_strut *st = &s->items[i];
+        char e0[32], e1[32];
+        snprintf(e0, sizeof e0, "%zu:%zu", st->comp[0], st->edge[0]);
+        snprintf(e1, sizeof e1, "%zu:%zu", st->comp[1], st->edge[1]);
+        printf("%6zu %12s %12s %10.6f %10.6f (%10.6f %10.6f %10.6f) (%10.6f %10.6f %10.6f) "
+               "%12.9f\n",
+               i, e0, e1, st->s, st->t, st->p[0], st->p[1], st->p[2], st->q[0], st->q[1],
+               st->q[2], st->length);
+    }
+    printf("\n%zu kink%s\n", nkinks, nkinks == 1 ? "" : "s");
+    if (nkinks > 0)
+        printf("%6s %6s %8s %12s\n", "#", "comp", "vertex", "minrad");
+    for (size_t i = 0; i < nkinks; i++)
+        printf("%6zu %6zu %8zu %12.9f\n", i, kinks[i].comp, kinks[i].vertex, kinks[i].minrad);
+}
+
+static json_t *struts_json(const char *name, const tk_measure *m, const tk_strut_list *s,
+                           const tk_kink *kinks, size_t nkinks)
+{
+    json_t *o = json_object();
+    json_t *list = json_array();
+    for (size_t i = 0; i < s->count; i++) {
+        const tk_strut *st = &s->items[i];
+        json_t *j = json_object();
+        json_object_set_new(j, "edges",
+                            json_pack("[[II][II]]", (json_int_t)st->comp[0],
+                                      (json_int_t)st->edge[0], (json_int_t)st->comp[1],
+                                      (json_int_t)st->edge[1]));
+        json_object_set_new(j, "s", json_number(st->s));
+        json_object_set_new(j, "t", json_number(st->t));
+        json_object_set_new(j, "p", json_point(st->p));
+        json_object_set_new(j, "q", json_point(st->q));
+        json_object_set_new(j, "length", json_number(st->length));
+        json_array_append_new(list, j);
+    }
+    json_t *klist = json_array();
+    for (size_t i = 0; i < nkinks; i++) {
+        json_t *j = json_object();
+        json_object_set_new(j, "comp", json_integer((json_int_t)kinks[i].comp));
+        json_object_set_new(j, "vertex", json_integer((json_int_t)kinks[i].vertex));
+        json_object_set_new(j, "minrad", json_number(kinks[i].minrad));
+        json_array_append_new(klist, j);
+    }
+    json_object_set_new(o, "file", json_name(name));
+    json_object_set_new(o, "thickness", json_number(m->thickness));
+    json_object_set_new(o, "struts", list);
+    json_object_set_new(o, "kinks", klist);
+    return o;
+}
+
+static int cmd_struts(int argc, char **argv)
+{
+    cli_args a;
+    if (parse_args("struts", argc, argv, OPT_JSON | OPT_TOLERANCE, &a))
+        return EXIT_USAGE;
+    if (a.help) {
+        fputs(struts_help, stdout);
+        return EXIT_OK;
+    }
+    if (a.npos != 1)
+        return usage_error("struts", a.npos == 0 ? "no FILE given" : "one FILE only");
+    const char *name = a.pos[0];
+    tk_curve *c = NULL;
+    tk_measure m;
+    tk_strut_list struts = {NULL, 0, 0};
+    tk_kink *kinks = NULL;
+    size_t nkinks = 0;
+    int status = load_and_measure(name, a.tolerance, &c, &m, &struts, &kinks, &nkinks);
+    if (status)
+        return status;
+    if (a.json)
+        status = print_json(struts_json(name, &m, &struts, kinks, nkinks));
+    else
+        print_struts_text(name, &m, &struts, kinks, nkinks, a.tolerance);
+    tk_strut_list_free(&struts);
+    free(kinks);
+    tk_curve_free(&c);
+    return status;
+}
+
+/* Builds the curve a generate command line asks for; EXIT_USAGE with a
+ * message when the shape or its arguments are wrong. */
+static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
+{
+    const char *cmd = "generate";
+    if (npos == 0)
+        return usage_error(cmd, "no SHAPE given (torus P Q, hopf, borromean or chain K)");
+    const char *shape = pos[0];
+    tk_error err;
+    tk_error_clear(&err);
+    int rc;
+    if (strcmp(shape, "torus") == 0) {
+        if (npos != 3)
+            return usage_error(cmd, "torus takes two arguments, P and Q");
+        long long p = 0, q = 0;
+        if (parse_integer(cmd, "torus P", pos[1], INT_MIN, INT_MAX, &p) ||
+            parse_integer(cmd, "torus Q", pos[2], INT_MIN, INT_MAX, &q))
+            return EXIT_USAGE;
+        rc = tk_generate_torus((int)p, (int)q, vertices, out, &err);
+    } else if (strcmp(shape, "hopf") == 0 || strcmp(shape, "borromean") == 0) {
+        if (npos != 1)
+            return usage_error(cmd, "%s takes no arguments", shape);
+        rc = shape[0] == 'h' ? tk_generate_hopf(vertices, out, &err)
+                             : tk_generate_borromean(vertices, out, &err);
+    } else if (strcmp(shape, "chain") == 0) {
+        if (npos != 2)
+            return usage_error(cmd, "chain takes one argument, K");
+        long long k = 0;
+        if (parse_integer(cmd, "chain K", pos[1], 1, INT_MAX, &k))
+            return EXIT_USAGE;
+        rc = tk_generate_chain((size_t)k, vertices, out, &err);
+    } else {
+        return usage_error(cmd, "unknown shape '%s' (torus P Q, hopf, borromean or chain K)",
+                           shape);
+    }
+    if (rc == TK_EINVAL || rc == TK_ELIMIT)
+        return usage_error(cmd, "%s", err.message);
+    if (rc) {
+        report(NULL, &err);
+        return EXIT_INPUT;
+    }
+    return EXIT_OK;
+}
+
+static int cmd_generate(int argc, char **argv)
+{
+    cli_args a;
+    if (parse_args("generate", argc, argv, OPT_VERTICES, &a))
+        return EXIT_USAGE;
+    if (a.help) {
+        fputs(generate_help, stdout);
+        return EXIT_OK;
+    }
+    tk_curve *c = NULL;
+    int status = make_shape(a.npos, a.pos, a.vertices, &c);
+    if (status)
+        return status;
+    tk_error err;
+    tk_error_clear(&err);
+    if (tk_vect_write(c, stdout, &err) != TK_OK) {
+        report(NULL, &err);
+        status = EXIT_INPUT;
+    }
+    tk_curve_free(&c);
+    return status;
+}
+
+static int cmd_help(int argc, char **argv)
+{
+    if (argc == 0) {
+        fputs(main_help, stdout);
+        return EXIT_OK;
+    }
+    if (argc > 1)
+        return usage_error("help", "one COMMAND only");
+    if (strcmp(argv[0], "info") == 0)
+        fputs(info_help, stdout);
+    else if (strcmp(argv[0], "struts") == 0)
+        fputs(struts_help, stdout);
+    else if (strcmp(argv[0], "generate") == 0)
+        fputs(generate_help, stdout);
+    else if (strcmp(argv[0], "help") == 0)
+        fputs(main_help, stdout);
+    else
+        return usage_error("help", "unknown command '%s'", argv[0]);
+    return EXIT_OK;
+}
+
+/* ------------------------------------------------------------------ main */
+
+typedef struct command {
+    const char *name;
+    int (*run)(int argc, char **argv);
+} command;
+
+static const command commands[] = {
+    {"info", cmd_info},
+    {"struts", cmd_struts},
+    {"generate", cmd_generate},
+    {"help", cmd_help},
+};
+
+/* Output errors (a full disk, a closed pipe) turn success into failure;
+ * a command that already failed has said why. */
+static int finish(int status)
+{
+    if ((fflush(stdout) != 0 || ferror(stdout)) && status == EXIT_OK) {
+        fprintf(stderr, "tightknot: writing standard output failed: %s\n", strerror(errno));
+        return EXIT_INPUT;
+    }
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fputs(main_help, stderr);
+        return EXIT_USAGE;
+    }
+    const char *name = argv[1];
+    if (strcmp(name, "-h") == 0 || strcmp(name, "--help") == 0)
+        return finish(cmd_help(0, NULL));
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (strcmp(name, commands[i].name) == 0)
+            return finish(commands[i].run(argc - 2, argv + 2));
+    return usage_error(NULL, "unknown command '%s'", name);
+}
