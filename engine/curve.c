@@ -419,7 +419,10 @@ static int spline_resample(const spline *sp, bool closed, size_t count, double *
         double x = total_u * ((double)seg + frac) / (double)dense;
         if (!closed && v == count - 1)
             x = total_u;
-        spline_eval(sp, x, out + 3 * v);
+        if (!closed && (v == 0 || v == count - 1))
+            memcpy(out + 3 * v, sp->y + 3 * (v == 0 ? 0 : sp->n - 1), 3 * sizeof *out);
+        else
+            spline_eval(sp, x, out + 3 * v);
     }
     free(arc);
     return TK_OK;
@@ -461,6 +464,9 @@ int tk_curve_resample_total(const tk_curve *src, size_t total, tk_curve **out,
                             tk_error *err)
 {
     *out = NULL;
+    int vrc = tk_curve_validate(src, err);
+    if (vrc)
+        return vrc;
     size_t minimum = 0;
     for (size_t i = 0; i < src->ncomp; i++)
         minimum += src->closed[i] ? 3 : 2;

@@ -582,6 +582,22 @@ int tk_strut_finder_shortest(tk_strut_finder *f, const tk_curve *c, double *shor
     return TK_OK;
 }
 
+int tk_strut_finder_closest_pair(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule,
+                                 double tau, double below, double *dist, tk_error *err)
+{
+    int rc = check_counts(f, c, err);
+    if (rc)
+        return rc;
+    if (rule == TK_ARC_ADMISSIBLE && !(tau > 0.0))
+        return tk_error_set(err, TK_EINVAL, "the diameter must be positive (got %g)", tau);
+    fill_prefix(f, c, rule, tau);
+    query qy = {f, c, rule, below, true, true, {{0}}, NULL, TK_OK};
+    if (f->nedges > 1)
+        visit(&qy, 0, 0);
+    *dist = qy.bound;
+    return TK_OK;
+}
+
 int tk_struts_find_brute(const tk_curve *c, tk_arc_rule rule, double tau, double bound,
                          tk_strut_list *out, tk_error *err)
 {

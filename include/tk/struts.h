@@ -90,6 +90,13 @@ int tk_strut_finder_shortest(tk_strut_finder *f, const tk_curve *c,
                              double *shortest, tk_strut *where,
                              tk_error *err);
 
+/* The smallest distance among edge pairs passing the arc rule, with no
+ * local-minimum test, when it is below `below`; otherwise `below`.  The
+ * flow's step control: by Theorem 3 a curve whose radii of curvature keep
+ * the bound has thickness >= tau exactly when this is >= tau. */
+int tk_strut_finder_closest_pair(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule,
+                                 double tau, double below, double *dist, tk_error *err);
+
 /* The same answers by checking every pair of edges: O(V^2), for tests and
  * for comparison in benchmarks. */
 int tk_struts_find_brute(const tk_curve *c, tk_arc_rule rule, double tau,
