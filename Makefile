@@ -29,7 +29,7 @@ CPPFLAGS += -Iinclude -Itests/support -I/usr/include/suitesparse -D_XOPEN_SOURCE
 CFLAGS += -std=c11 $(OPT) -g -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
 	-Wmissing-prototypes -Wno-missing-field-initializers -MMD -MP $(SAN_FLAGS)
 LDFLAGS += $(SAN_FLAGS)
-LDLIBS += -lm -lpthread
+LDLIBS += -lcholmod -lsuitesparseconfig -llapack -lblas -lm -lpthread
 
 ifeq ($(V),1)
 Q :=

@@ -3,6 +3,8 @@
  *   tightknot info [--json] [--tolerance EPS] FILE...
  *   tightknot struts [--json] [--tolerance EPS] FILE
  *   tightknot generate torus P Q | hopf | borromean | chain K [--vertices N]
+ *   tightknot tighten FILE [run options] [-o OUT] [--struts OUT] [--log OUT]
+ *                    [--snapshots DIR --every K] [--json]
  *
  * One static function per subcommand; options are parsed by one shared
  * helper that knows which options each subcommand accepts.  Options may
@@ -28,7 +30,11 @@
 #include "tk/generate.h"
 #include "tk/struts.h"
 #include "tk/thickness.h"
+#include "tk/tighten.h"
 #include "tk/vect.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
 
 enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_INPUT = 2 };
 
@@ -46,6 +52,7 @@ static const char main_help[] =
     "  struts     the struts (self-contacts) and kinks of one VECT file\n"
     "  generate   write an example knot or link (torus, Hopf, Borromean,\n"
     "             chain) as VECT on standard output\n"
+    "  tighten    tighten a knot or link: shorten it keeping the tube embedded\n"
     "  help       show the help of a command: tightknot help info\n"
     "\n"
     "Options:\n"
@@ -157,13 +164,72 @@ static const char generate_help[] =
     "Example:\n"
     "  tightknot generate torus 2 3 --vertices 150 > trefoil.vect\n";
 
+static const char tighten_help[] =
+    "usage: tightknot tighten FILE [OPTIONS]\n"
+    "\n"
+    "Tightens the knot or link in FILE (\"-\" is standard input) by the\n"
+    "constrained gradient flow: the curve gets shorter while the tube of\n"
+    "the given radius around it stays embedded (struts and kinks are the\n"
+    "active constraints, resolved by non-negative least squares).\n"
+    "\n"
+    "Run options:\n"
+    "  --radius R        tube radius (default 0.5, so the diameter is 1)\n"
+    "  --lambda L        stiffness: minrad >= L * radius (default 1)\n"
+    "  --resolution R    first resample to R vertices per unit ropelength\n"
+    "                    (5 quick, 10 medium, 20 fine; default: keep the\n"
+    "                    input's vertices)\n"
+    "  --autoscale       first scale the curve so its thickness is just above\n"
+    "                    the diameter (needed when the input is thinner)\n"
+    "Stop criteria (the first met stops the run; default --steps 1000):\n"
+    "  --steps N         after N steps\n"
+    "  --time SECONDS    after this much wall time\n"
+    "  --residual X      when the residual (|resolved gradient| / |gradient|)\n"
+    "                    falls below X\n"
+    "Outputs:\n"
+    "  -o, --output OUT.vect   the tightened curve (VECT)\n"
+    "  --struts OUT.json       the final struts and kinks with their forces\n"
+    "  --log OUT.tsv           one line of figures per step\n"
+    "  --snapshots DIR         write DIR/step-NNNNNN.vect every K steps\n"
+    "  --every K               snapshot interval (default 100)\n"
+    "  --json                  print one JSON object with the final figures:\n"
+    "                          ropelength, length, thickness, minrad, vertices,\n"
+    "                          components, steps, seconds, residual, struts,\n"
+    "                          kinks, stop_reason\n"
+    "  -h, --help              show this help\n"
+    "\n"
+    "A progress line goes to standard error when it is a terminal.  The\n"
+    "conventions are those of 'tightknot info': thickness is the tube\n"
+    "diameter, ropelength = 2 * length / thickness.\n"
+    "\n"
+    "Exit status: 0 success, 1 usage error, 2 bad input or a failed run.\n"
+    "\n"
+    "Example:\n"
+    "  tightknot tighten ../shared/catalogue/3.1.vect --autoscale --resolution 5 \\\n"
+    "      --time 60 -o trefoil-tight.vect --json\n";
+
 /* -------------------------------------------------------- option parsing */
 
 enum {
     OPT_JSON = 1u << 0,
     OPT_TOLERANCE = 1u << 1,
-    OPT_VERTICES = 1u << 2
+    OPT_VERTICES = 1u << 2,
+    OPT_RADIUS = 1u << 3,
+    OPT_LAMBDA = 1u << 4,
+    OPT_RESOLUTION = 1u << 5,
+    OPT_AUTOSCALE = 1u << 6,
+    OPT_STEPS = 1u << 7,
+    OPT_TIME = 1u << 8,
+    OPT_RESIDUAL = 1u << 9,
+    OPT_OUTPUT = 1u << 10,
+    OPT_STRUTS_OUT = 1u << 11,
+    OPT_LOG = 1u << 12,
+    OPT_SNAPSHOTS = 1u << 13,
+    OPT_EVERY = 1u << 14
 };
+#define TIGHTEN_OPTIONS                                                                   \
+    (OPT_JSON | OPT_RADIUS | OPT_LAMBDA | OPT_RESOLUTION | OPT_AUTOSCALE | OPT_STEPS |     \
+     OPT_TIME | OPT_RESIDUAL | OPT_OUTPUT | OPT_STRUTS_OUT | OPT_LOG | OPT_SNAPSHOTS |     \
+     OPT_EVERY)
 
 typedef struct option_spec {
     const char *name;
@@ -175,6 +241,18 @@ static const option_spec option_specs[] = {
     {"json", OPT_JSON, false},
     {"tolerance", OPT_TOLERANCE, true},
     {"vertices", OPT_VERTICES, true},
+    {"radius", OPT_RADIUS, true},
+    {"lambda", OPT_LAMBDA, true},
+    {"resolution", OPT_RESOLUTION, true},
+    {"autoscale", OPT_AUTOSCALE, false},
+    {"steps", OPT_STEPS, true},
+    {"time", OPT_TIME, true},
+    {"residual", OPT_RESIDUAL, true},
+    {"output", OPT_OUTPUT, true},
+    {"struts", OPT_STRUTS_OUT, true},
+    {"log", OPT_LOG, true},
+    {"snapshots", OPT_SNAPSHOTS, true},
+    {"every", OPT_EVERY, true},
 };
 
 typedef struct cli_args {
@@ -182,6 +260,10 @@ typedef struct cli_args {
     bool json;
     double tolerance;
     size_t vertices; /* 0: the generator's default */
+    tk_options run;  /* tighten's run options */
+    bool steps_given;
+    const char *output, *struts_out, *log_out, *snapshots;
+    size_t every;
     int npos;        /* the arguments that are not options, in order */
     char **pos;
 } cli_args;
@@ -262,6 +344,64 @@ static int apply_option(const char *cmd, unsigned flag, const char *value, cli_a
         a->vertices = (unsigned long long)n > SIZE_MAX ? SIZE_MAX : (size_t)n;
         return EXIT_OK;
     }
+    case OPT_RADIUS:
+    case OPT_LAMBDA:
+    case OPT_RESOLUTION:
+    case OPT_TIME:
+    case OPT_RESIDUAL: {
+        double x = 0.0;
+        const char *name = flag == OPT_RADIUS       ? "--radius"
+                           : flag == OPT_LAMBDA     ? "--lambda"
+                           : flag == OPT_RESOLUTION ? "--resolution"
+                           : flag == OPT_TIME       ? "--time"
+                                                    : "--residual";
+        if (parse_real(cmd, name, value, &x))
+            return EXIT_USAGE;
+        bool positive_needed = flag == OPT_RADIUS || flag == OPT_LAMBDA;
+        if (positive_needed ? !(x > 0.0) : x < 0.0)
+            return usage_error(cmd, "%s: '%s' must be %s", name, value,
+                               positive_needed ? "positive" : "zero or more");
+        if (flag == OPT_RADIUS)
+            a->run.radius = x;
+        else if (flag == OPT_LAMBDA)
+            a->run.lambda = x;
+        else if (flag == OPT_RESOLUTION)
+            a->run.resolution = x;
+        else if (flag == OPT_TIME)
+            a->run.max_seconds = x;
+        else
+            a->run.min_residual = x;
+        return EXIT_OK;
+    }
+    case OPT_AUTOSCALE:
+        a->run.autoscale = true;
+        return EXIT_OK;
+    case OPT_STEPS:
+    case OPT_EVERY: {
+        long long n = 0;
+        if (parse_integer(cmd, flag == OPT_STEPS ? "--steps" : "--every", value, 1, LONG_MAX,
+                          &n))
+            return EXIT_USAGE;
+        if (flag == OPT_STEPS) {
+            a->run.max_steps = (long)n;
+            a->steps_given = true;
+        } else {
+            a->every = (size_t)n;
+        }
+        return EXIT_OK;
+    }
+    case OPT_OUTPUT:
+        a->output = value;
+        return EXIT_OK;
+    case OPT_STRUTS_OUT:
+        a->struts_out = value;
+        return EXIT_OK;
+    case OPT_LOG:
+        a->log_out = value;
+        return EXIT_OK;
+    case OPT_SNAPSHOTS:
+        a->snapshots = value;
+        return EXIT_OK;
     default:
         return usage_error(cmd, "internal error: option %u", flag);
     }
@@ -278,6 +418,11 @@ static int parse_args(const char *cmd, int argc, char **argv, unsigned allowed,
     a->json = false;
     a->tolerance = DEFAULT_TOLERANCE;
     a->vertices = 0;
+    tk_options defaults = TK_OPTIONS_INIT;
+    a->run = defaults;
+    a->steps_given = false;
+    a->output = a->struts_out = a->log_out = a->snapshots = NULL;
+    a->every = 100;
     a->npos = 0;
     a->pos = argv;
     bool options_done = false;
@@ -293,6 +438,12 @@ static int parse_args(const char *cmd, int argc, char **argv, unsigned allowed,
         }
         if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
             a->help = true;
+            continue;
+        }
+        if (strcmp(arg, "-o") == 0 && (allowed & OPT_OUTPUT)) {
+            if (i + 1 >= argc)
+                return usage_error(cmd, "option -o needs a value");
+            a->output = argv[++i];
             continue;
         }
         const option_spec *spec = NULL;
@@ -520,7 +671,7 @@ static void print_struts_text(const char *name, const tk_measure *m, const tk_st
 }
 
 static json_t *struts_json(const char *name, const tk_measure *m, const tk_strut_list *s,
-                           const tk_kink *kinks, size_t nkinks)
+                           const tk_kink *kinks, size_t nkinks, bool with_force)
 {
     json_t *o = json_object();
     json_t *list = json_array();
@@ -536,6 +687,8 @@ static json_t *struts_json(const char *name, const tk_measure *m, const tk_strut
         json_object_set_new(j, "p", json_point(st->p));
         json_object_set_new(j, "q", json_point(st->q));
         json_object_set_new(j, "length", json_number(st->length));
+        if (with_force)
+            json_object_set_new(j, "force", json_number(st->force));
         json_array_append_new(list, j);
     }
     json_t *klist = json_array();
@@ -544,6 +697,8 @@ static json_t *struts_json(const char *name, const tk_measure *m, const tk_strut
         json_object_set_new(j, "comp", json_integer((json_int_t)kinks[i].comp));
         json_object_set_new(j, "vertex", json_integer((json_int_t)kinks[i].vertex));
         json_object_set_new(j, "minrad", json_number(kinks[i].minrad));
+        if (with_force)
+            json_object_set_new(j, "force", json_number(kinks[i].force));
         json_array_append_new(klist, j);
     }
     json_object_set_new(o, "file", json_name(name));
@@ -574,7 +729,7 @@ static int cmd_struts(int argc, char **argv)
     if (status)
         return status;
     if (a.json)
-        status = print_json(struts_json(name, &m, &struts, kinks, nkinks));
+        status = print_json(struts_json(name, &m, &struts, kinks, nkinks, false));
     else
         print_struts_text(name, &m, &struts, kinks, nkinks, a.tolerance);
     tk_strut_list_free(&struts);
@@ -650,6 +805,184 @@ static int cmd_generate(int argc, char **argv)
     return status;
 }
 
+/* What the tighten command's progress callback needs. */
+typedef struct tighten_watch {
+    bool terminal;       /* progress line on stderr */
+    double last_print;   /* seconds of the last progress line */
+    FILE *log;
+    const char *snapshots;
+    size_t every;
+    tk_run *run;
+    int failed;          /* an output could not be written */
+} tighten_watch;
+
+static int write_vect_file(const char *path, const tk_curve *c)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "tightknot: cannot write %s: %s\n", path, strerror(errno));
+        return EXIT_INPUT;
+    }
+    tk_error err;
+    tk_error_clear(&err);
+    int rc = tk_vect_write(c, f, &err);
+    if (fclose(f) != 0 && rc == TK_OK)
+        rc = tk_error_set(&err, TK_EIO, "closing failed: %s", strerror(errno));
+    if (rc) {
+        fprintf(stderr, "tightknot: %s: %s\n", path, err.message);
+        return EXIT_INPUT;
+    }
+    return EXIT_OK;
+}
+
+static int tighten_progress(const tk_step_report *s, void *user)
+{
+    tighten_watch *w = user;
+    if (w->log)
+        fprintf(w->log, "%ld\t%.6f\t%.12g\t%.12g\t%.12g\t%.12g\t%.6g\t%zu\t%zu\t%.6g\t%.6g\t%.3g\t%d\n",
+                s->step, s->seconds, s->ropelength, s->length, s->thickness, s->minrad,
+                s->residual, s->struts, s->kinks, s->step_size, s->rcond, s->violation,
+                s->corrections);
+    if (w->snapshots && s->step % (long)w->every == 0) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/step-%06ld.vect", w->snapshots, s->step);
+        if (write_vect_file(path, tk_run_curve(w->run)) != EXIT_OK) {
+            w->failed = 1;
+            return 1;
+        }
+    }
+    if (w->terminal && (s->seconds - w->last_print > 0.2 || s->step == 1)) {
+        w->last_print = s->seconds;
+        fprintf(stderr, "\rstep %7ld  ropelength %.6f  struts %5zu  kinks %4zu  residual %.3g  %.1f s ",
+                s->step, s->ropelength, s->struts, s->kinks, s->residual, s->seconds);
+        fflush(stderr);
+    }
+    return 0;
+}
+
+static int write_struts_file(const char *path, const char *name, tk_run *run)
+{
+    const tk_step_report *last = tk_run_latest(run);
+    tk_measure m = {last->length, last->minrad, NAN, last->thickness, last->ropelength};
+    size_t ns = 0, nk = 0;
+    const tk_strut *st = tk_run_struts(run, &ns);
+    const tk_kink *kinks = tk_run_kinks(run, &nk);
+    tk_strut_list list = {(tk_strut *)st, ns, ns};
+    json_t *o = struts_json(name, &m, &list, kinks, nk, true);
+    char *text = o ? json_dumps(o, JSON_INDENT(1) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17))
+                   : NULL;
+    json_decref(o);
+    FILE *f = text ? fopen(path, "w") : NULL;
+    int ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
+    if (f && fclose(f) != 0)
+        ok = 0;
+    free(text);
+    if (!ok) {
+        fprintf(stderr, "tightknot: cannot write %s: %s\n", path, strerror(errno));
+        return EXIT_INPUT;
+    }
+    return EXIT_OK;
+}
+
+static int cmd_tighten(int argc, char **argv)
+{
+    cli_args a;
+    if (parse_args("tighten", argc, argv, TIGHTEN_OPTIONS, &a))
+        return EXIT_USAGE;
+    if (a.help) {
+        fputs(tighten_help, stdout);
+        return EXIT_OK;
+    }
+    if (a.npos != 1)
+        return usage_error("tighten", a.npos == 0 ? "no FILE given" : "one FILE only");
+    if (!a.steps_given && a.run.max_seconds == 0.0 && a.run.min_residual == 0.0)
+        a.run.max_steps = 1000;
+    const char *name = a.pos[0];
+    tk_error err;
+    tk_error_clear(&err);
+    tk_curve *c = NULL;
+    if (tk_vect_read_file(input_path(name), NULL, &c, &err) != TK_OK) {
+        report(NULL, &err);
+        return EXIT_INPUT;
+    }
+    if (a.snapshots && mkdir(a.snapshots, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "tightknot: cannot make %s: %s\n", a.snapshots, strerror(errno));
+        tk_curve_free(&c);
+        return EXIT_INPUT;
+    }
+    tighten_watch w = {isatty(STDERR_FILENO) != 0, -1.0, NULL, a.snapshots, a.every, NULL, 0};
+    if (a.log_out) {
+        w.log = fopen(a.log_out, "w");
+        if (!w.log) {
+            fprintf(stderr, "tightknot: cannot write %s: %s\n", a.log_out, strerror(errno));
+            tk_curve_free(&c);
+            return EXIT_INPUT;
+        }
+        fputs("step\tseconds\tropelength\tlength\tthickness\tminrad\tresidual\tstruts\tkinks\t"
+              "step_size\trcond\tviolation\tcorrections\n",
+              w.log);
+    }
+    tk_run *run = NULL;
+    int status = EXIT_OK;
+    if (tk_run_new(c, &a.run, &run, &err) != TK_OK) {
+        report(name, &err);
+        status = EXIT_INPUT;
+        goto done;
+    }
+    w.run = run;
+    tighten_progress(tk_run_latest(run), &w);
+    tk_run_set_progress(run, tighten_progress, &w);
+    tk_stop_reason why = TK_STOP_NONE;
+    int rc = tk_run_until(run, &why, &err);
+    if (w.terminal)
+        fputc('\n', stderr);
+    if (rc != TK_OK) {
+        report(name, &err);
+        status = EXIT_INPUT;
+    }
+    if (w.failed)
+        status = EXIT_INPUT;
+    if (a.output && write_vect_file(a.output, tk_run_curve(run)) != EXIT_OK)
+        status = EXIT_INPUT;
+    if (a.struts_out && write_struts_file(a.struts_out, name, run) != EXIT_OK)
+        status = EXIT_INPUT;
+    const tk_step_report *last = tk_run_latest(run);
+    const tk_curve *fin = tk_run_curve(run);
+    if (a.json) {
+        json_t *o = json_object();
+        json_object_set_new(o, "file", json_name(name));
+        json_object_set_new(o, "ropelength", json_number(last->ropelength));
+        json_object_set_new(o, "length", json_number(last->length));
+        json_object_set_new(o, "thickness", json_number(last->thickness));
+        json_object_set_new(o, "minrad", json_number(last->minrad));
+        json_object_set_new(o, "vertices", json_integer((json_int_t)fin->nvert));
+        json_object_set_new(o, "components", json_integer((json_int_t)fin->ncomp));
+        json_object_set_new(o, "steps", json_integer((json_int_t)last->step));
+        json_object_set_new(o, "seconds", json_number(last->seconds));
+        json_object_set_new(o, "residual", json_number(last->residual));
+        json_object_set_new(o, "struts", json_integer((json_int_t)last->struts));
+        json_object_set_new(o, "kinks", json_integer((json_int_t)last->kinks));
+        json_object_set_new(o, "stop_reason", json_string(tk_stop_reason_name(why)));
+        if (print_json(o) != EXIT_OK)
+            status = EXIT_INPUT;
+    } else {
+        printf("%s: %ld steps in %.2f s (stopped: %s)\n", name, last->step, last->seconds,
+               tk_stop_reason_name(why));
+        printf("  ropelength %.9g  length %.9g  thickness %.9g  minrad %.9g\n",
+               last->ropelength, last->length, last->thickness, last->minrad);
+        printf("  vertices %zu  components %zu  struts %zu  kinks %zu  residual %.3g\n",
+               fin->nvert, fin->ncomp, last->struts, last->kinks, last->residual);
+    }
+done:
+    if (w.log && fclose(w.log) != 0) {
+        fprintf(stderr, "tightknot: writing %s failed: %s\n", a.log_out, strerror(errno));
+        status = EXIT_INPUT;
+    }
+    tk_run_free(&run);
+    tk_curve_free(&c);
+    return status;
+}
+
 static int cmd_help(int argc, char **argv)
 {
     if (argc == 0) {
@@ -664,6 +997,8 @@ static int cmd_help(int argc, char **argv)
         fputs(struts_help, stdout);
     else if (strcmp(argv[0], "generate") == 0)
         fputs(generate_help, stdout);
+    else if (strcmp(argv[0], "tighten") == 0)
+        fputs(tighten_help, stdout);
     else if (strcmp(argv[0], "help") == 0)
         fputs(main_help, stdout);
     else
@@ -682,6 +1017,7 @@ static const command commands[] = {
     {"info", cmd_info},
     {"struts", cmd_struts},
     {"generate", cmd_generate},
+    {"tighten", cmd_tighten},
     {"help", cmd_help},
 };
 

@@ -1,0 +1,1000 @@
+/* Sparse non-negative least squares by block principal pivoting.
+ *
+ * The problem min ||A x - b||, x >= 0 is the linear complementarity problem
+ *     y = A^T (A x - b),  x >= 0,  y >= 0,  x_i y_i = 0.
+ * Block principal pivoting (Portugal, Judice and Vicente 1994; Kim and Park
+ * 2011, the single right-hand-side algorithm) keeps a partition of the
+ * variables into a passive set F, where x_F solves the unconstrained
+ * problem min ||A_F x_F - b|| and y_F = 0, and an active set G, where
+ * x_G = 0 and y_G = A_G^T (A_F x_F - b).  A variable is infeasible when
+ * x_i < 0 (i in F) or y_i < 0 (i in G); every infeasible variable changes
+ * side at once while their number keeps falling, a budget of
+ * NNLS_FULL_EXCHANGE_BUDGET exchanges may fail to reduce it, and after that
+ * only the infeasible variable of largest index changes side (Murty's rule,
+ * Judice and Pires), which terminates for a positive definite A^T A.
+ *
+ * Tolerances are scale-free: with s_i = ||a_i||, x_i is infeasible when
+ * s_i x_i < -tol ||b|| and y_i when y_i / s_i < -tol ||b||; both sides are
+ * in units of b, so scaling a column or b changes nothing.  Zero columns
+ * never enter F (any x_i is optimal for them; 0 is returned).
+ *
+ * The unconstrained subproblems use the normal equations.  With
+ * T = A_F^T (n_F x m, built here column by column from A), CHOLMOD's
+ * unsymmetric mode factors T T' + beta I = A_F^T A_F + beta I directly, so
+ * M = A_F^T A_F is never stored.  The symbolic analysis depends only on
+ * T's pattern, which is kept (a copy of it) with the factor in a small
+ * least-recently-used cache; a solve of the same problem pattern (the
+ * passive-set sequence from x = 0 repeats from one flow step to the next)
+ * re-uses the analyses.  Each solve is followed by a step of iterative
+ * refinement whose residual is formed from T, not from the factor
+ * (corrected semi-normal equations), which wins back most of the accuracy
+ * lost to the squared condition number.
+ *
+ * Condition: the estimate is the ratio of the smallest to the largest pivot
+ * of the factorisation, (min L_jj / max L_jj)^2 for LL' (supernodal) and
+ * min d_j / max d_j for LDL' (simplicial): both estimate rcond(M) itself,
+ * not rcond(L), and equal what cholmod_rcond returns in SuiteSparse 5.x.
+ * It is a rough estimate (an upper bound in spirit, exact for diagonal M).
+ * The scan is done here because a simplicial LDL' factorisation of a
+ * singular or indefinite M "succeeds" with zero or negative pivots, which
+ * CHOLMOD does not flag; such a factor reports 0.  When the estimate is
+ * below rcond_floor (or CHOLMOD reports the matrix not positive
+ * definite), the factorisation is repeated with beta = delta * max(diag M),
+ * delta = 1e-12, 1e-10, ..., 1e-2, until the estimate clears the floor.
+ */
+#include "tk/nnls.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Enough slots for the handful of passive sets one solve visits. */
+#define NNLS_SLOTS 8
+#define NNLS_FULL_EXCHANGE_BUDGET 3
+#define NNLS_DELTA_FIRST 1e-12
+#define NNLS_DELTA_GROWTH 100.0
+#define NNLS_DELTA_CAP 1e-2
+#define NNLS_DEFAULT_TOLERANCE 1e-10
+#define NNLS_DEFAULT_RCOND_FLOOR 1e-14
+
+/* A cached symbolic analysis (and the last numeric factor) for one
+ * pattern of T. */
+typedef struct nnls_slot {
+    cholmod_factor *L;    /* NULL when the slot is empty */
+    uint64_t hash;
+    size_t nrow, ncol, nnz;
+    int *p, *i;           /* T's pattern: ncol + 1 and nnz entries */
+    unsigned long used;   /* least-recently-used stamp */
+} nnls_slot;
+
+struct tk_nnls {
+    cholmod_common cc;
+    nnls_slot slot[NNLS_SLOTS];
+    unsigned long clock;
+    cholmod_dense *X, *Y, *E;  /* cholmod_solve2's result and workspace */
+};
+
+/* The outcome of one (possibly regularised) factorisation. */
+typedef struct nnls_factor {
+    cholmod_factor *L;
+    double delta;         /* added to the (unit) diagonal, 0 if none */
+    double rcond;         /* estimate for the unregularised M; 0 if singular;
+                             left alone when only regularised ones were tried */
+    int factorisations;   /* cholmod_factorize_p calls made */
+    bool singular;        /* too ill-conditioned, and not regularised */
+} nnls_factor;
+
+/* ------------------------------------------------------------------ */
+/* Small helpers. */
+
+static void col_span(const cholmod_sparse *A, size_t j, size_t *lo, size_t *hi)
+{
+    const int *Ap = A->p;
+    *lo = (size_t)Ap[j];
+    *hi = A->packed ? (size_t)Ap[j + 1] : (size_t)Ap[j] + (size_t)((const int *)A->nz)[j];
+}
+
+static double col_dot(const cholmod_sparse *A, size_t j, const double *v)
+{
+    const int *Ai = A->i;
+    const double *Ax = A->x;
+    size_t lo, hi;
+    col_span(A, j, &lo, &hi);
+    double sum = 0.0;
+    for (size_t e = lo; e < hi; e++)
+        sum += Ax[e] * v[Ai[e]];
+    return sum;
+}
+
+static double norm2(const double *v, size_t n)
+{
+    /* scaled, so that huge or tiny inputs neither overflow nor underflow */
+    double scale = 0.0, ssq = 1.0;
+    for (size_t k = 0; k < n; k++) {
+        double a = fabs(v[k]);
+        if (a == 0.0)
+            continue;
+        if (a > scale) {
+            ssq = 1.0 + ssq * (scale / a) * (scale / a);
+            scale = a;
+        } else {
+            ssq += (a / scale) * (a / scale);
+        }
+    }
+    return scale * sqrt(ssq);
+}
+
+static int cholmod_failure(tk_nnls *s, const char *what, tk_error *err)
+{
+    int status = s->cc.status;
+    if (status == CHOLMOD_OUT_OF_MEMORY)
+        return tk_error_set(err, TK_ENOMEM, "out of memory in CHOLMOD (%s)", what);
+    if (status == CHOLMOD_TOO_LARGE)
+        return tk_error_set(err, TK_ELIMIT, "problem too large for CHOLMOD (%s)", what);
+    return tk_error_set(err, TK_ENUMERIC, "CHOLMOD failed in %s (status %d)", what, status);
+}
+
+/* Checks what the solver relies on: a real, double, int-indexed,
+ * unsymmetric matrix with row indices in range and finite values. */
+static int check_matrix(const cholmod_sparse *A, tk_error *err)
+{
+    if (!A)
+        return tk_error_set(err, TK_EINVAL, "nnls: no matrix");
+    if (A->stype != 0 || A->xtype != CHOLMOD_REAL || A->dtype != CHOLMOD_DOUBLE ||
+        A->itype != CHOLMOD_INT)
+        return tk_error_set(err, TK_EINVAL,
+                            "nnls: the matrix must be real, double, int-indexed and unsymmetric");
+    if (A->nrow > INT_MAX || A->ncol > INT_MAX)
+        return tk_error_set(err, TK_ELIMIT, "nnls: matrix %zu x %zu is too large", A->nrow,
+                            A->ncol);
+    if (A->ncol > 0 && (!A->p || (!A->packed && !A->nz)))
+        return tk_error_set(err, TK_EINVAL, "nnls: the matrix has no column pointers");
+    const int *Ai = A->i;
+    const double *Ax = A->x;
+    for (size_t j = 0; j < A->ncol; j++) {
+        size_t lo, hi;
+        col_span(A, j, &lo, &hi);
+        if (hi < lo || (hi > lo && (!Ai || !Ax)))
+            return tk_error_set(err, TK_EINVAL, "nnls: column %zu is malformed", j);
+        for (size_t e = lo; e < hi; e++) {
+            if (Ai[e] < 0 || (size_t)Ai[e] >= A->nrow)
+                return tk_error_set(err, TK_EINVAL, "nnls: row index %d out of range in column %zu",
+                                    Ai[e], j);
+            if (!isfinite(Ax[e]))
+                return tk_error_set(err, TK_EINVAL, "nnls: non-finite entry in column %zu", j);
+        }
+    }
+    return TK_OK;
+}
+
+static int check_vector(const double *v, size_t n, const char *name, tk_error *err)
+{
+    if (n > 0 && !v)
+        return tk_error_set(err, TK_EINVAL, "nnls: no %s vector", name);
+    for (size_t k = 0; k < n; k++)
+        if (!isfinite(v[k]))
+            return tk_error_set(err, TK_EINVAL, "nnls: %s[%zu] is not finite", name, k);
+    return TK_OK;
+}
+
+/* T = A(:, F)^T, written into T's storage (allocated with m columns and
+ * nzmax >= nnz(A)); next is workspace of m ints.  Row indices come out
+ * sorted because F is walked in order. */
+static void build_transpose(const cholmod_sparse *A, const int *F, size_t nf,
+                            const double *inv_norm, cholmod_sparse *T, int *next)
+{
+    size_t m = A->nrow;
+    int *Tp = T->p, *Ti = T->i;
+    double *Tx = T->x;
+    const int *Ai = A->i;
+    const double *Ax = A->x;
+    memset(Tp, 0, (m + 1) * sizeof *Tp);
+    for (size_t q = 0; q < nf; q++) {
+        size_t lo, hi;
+        col_span(A, (size_t)F[q], &lo, &hi);
+        for (size_t e = lo; e < hi; e++)
+            Tp[Ai[e] + 1]++;
+    }
+    for (size_t k = 0; k < m; k++)
+        Tp[k + 1] += Tp[k];
+    memcpy(next, Tp, m * sizeof *next);
+    for (size_t q = 0; q < nf; q++) {
+        size_t lo, hi;
+        col_span(A, (size_t)F[q], &lo, &hi);
+        for (size_t e = lo; e < hi; e++) {
+            int dst = next[Ai[e]]++;
+            Ti[dst] = (int)q;
+            Tx[dst] = Ax[e] * inv_norm[F[q]];
+        }
+    }
+    T->nrow = nf;
+    T->sorted = 1;
+    T->packed = 1;
+}
+
+/* w = T' z (m entries). */
+static void t_transpose_times(const cholmod_sparse *T, const double *z, double *w)
+{
+    const int *Tp = T->p, *Ti = T->i;
+    const double *Tx = T->x;
+    for (size_t k = 0; k < T->ncol; k++) {
+        double sum = 0.0;
+        for (int e = Tp[k]; e < Tp[k + 1]; e++)
+            sum += Tx[e] * z[Ti[e]];
+        w[k] = sum;
+    }
+}
+
+/* out = T w (nrow entries). */
+static void t_times(const cholmod_sparse *T, const double *w, double *out)
+{
+    const int *Tp = T->p, *Ti = T->i;
+    const double *Tx = T->x;
+    memset(out, 0, T->nrow * sizeof *out);
+    for (size_t k = 0; k < T->ncol; k++) {
+        double wk = w[k];
+        if (wk == 0.0)
+            continue;
+        for (int e = Tp[k]; e < Tp[k + 1]; e++)
+            out[Ti[e]] += Tx[e] * wk;
+    }
+}
+
+/* ------------------------------------------------------------------ */
+/* The factor cache. */
+
+static uint64_t pattern_hash(const cholmod_sparse *T)
+{
+    /* FNV-1a over the dimensions and the pattern */
+    uint64_t h = 1469598103934665603ULL;
+    const int *Tp = T->p, *Ti = T->i;
+    size_t nnz = (size_t)Tp[T->ncol];
+    uint64_t dims[2] = {T->nrow, T->ncol};
+    for (int k = 0; k < 2; k++) {
+        h ^= dims[k];
+        h *= 1099511628211ULL;
+    }
+    for (size_t k = 0; k <= T->ncol; k++) {
+        h ^= (uint32_t)Tp[k];
+        h *= 1099511628211ULL;
+    }
+    for (size_t k = 0; k < nnz; k++) {
+        h ^= (uint32_t)Ti[k];
+        h *= 1099511628211ULL;
+    }
+    return h;
+}
+
+static void slot_clear(tk_nnls *s, nnls_slot *slot)
+{
+    if (slot->L)
+        cholmod_free_factor(&slot->L, &s->cc);
+    free(slot->p);
+    free(slot->i);
+    memset(slot, 0, sizeof *slot);
+}
+
+static nnls_slot *slot_find(tk_nnls *s, const cholmod_sparse *T, uint64_t h)
+{
+    const int *Tp = T->p, *Ti = T->i;
+    size_t nnz = (size_t)Tp[T->ncol];
+    for (int k = 0; k < NNLS_SLOTS; k++) {
+        nnls_slot *slot = &s->slot[k];
+        if (slot->L && slot->hash == h && slot->nrow == T->nrow && slot->ncol == T->ncol &&
+            slot->nnz == nnz && memcmp(slot->p, Tp, (T->ncol + 1) * sizeof *Tp) == 0 &&
+            memcmp(slot->i, Ti, nnz * sizeof *Ti) == 0)
+            return slot;
+    }
+    return NULL;
+}
+
+/* Analyses T into the least recently used slot. */
+static int slot_fill(tk_nnls *s, const cholmod_sparse *T, uint64_t h, nnls_slot **out,
+                     tk_error *err)
+{
+    nnls_slot *slot = &s->slot[0];
+    for (int k = 1; k < NNLS_SLOTS && slot->L; k++)
+        if (!s->slot[k].L || s->slot[k].used < slot->used)
+            slot = &s->slot[k];
+    slot_clear(s, slot);
+    const int *Tp = T->p, *Ti = T->i;
+    size_t nnz = (size_t)Tp[T->ncol];
+    slot->p = malloc((T->ncol + 1) * sizeof *slot->p);
+    slot->i = malloc((nnz ? nnz : 1) * sizeof *slot->i);
+    if (!slot->p || !slot->i) {
+        slot_clear(s, slot);
+        return tk_error_set(err, TK_ENOMEM, "out of memory for the factor cache");
+    }
+    /* cholmod_analyze takes a non-const matrix but does not change it */
+    slot->L = cholmod_analyze((cholmod_sparse *)T, &s->cc);
+    if (!slot->L || s->cc.status < CHOLMOD_OK) {
+        int rc = cholmod_failure(s, "analyze", err);
+        slot_clear(s, slot);
+        return rc;
+    }
+    memcpy(slot->p, Tp, (T->ncol + 1) * sizeof *Tp);
+    memcpy(slot->i, Ti, nnz * sizeof *Ti);
+    slot->hash = h;
+    slot->nrow = T->nrow;
+    slot->ncol = T->ncol;
+    slot->nnz = nnz;
+    *out = slot;
+    return TK_OK;
+}
+
+/* The pivot-ratio estimate of rcond(M) described at the top; 0 when a
+ * pivot is zero, negative or not finite. */
+static double factor_rcond(const cholmod_factor *L)
+{
+    const double *Lx = L->x;
+    double lo = INFINITY, hi = 0.0;
+    if (L->n == 0)
+        return 1.0;
+    if (L->is_super) {
+        const int *super = L->super, *pi = L->pi, *px = L->px;
+        for (size_t sn = 0; sn < L->nsuper; sn++) {
+            int k1 = super[sn], k2 = super[sn + 1];
+            size_t nsrow = (size_t)(pi[sn + 1] - pi[sn]);
+            for (int j = k1; j < k2; j++) {
+                size_t jj = (size_t)(j - k1);
+                double d = Lx[(size_t)px[sn] + jj + jj * nsrow];
+                if (!(d > 0.0) || !isfinite(d))
+                    return 0.0;
+                lo = fmin(lo, d);
+                hi = fmax(hi, d);
+            }
+        }
+    } else {
+        const int *Lp = L->p;
+        for (size_t j = 0; j < L->n; j++) {
+            double d = Lx[Lp[j]];
+            if (!(d > 0.0) || !isfinite(d))
+                return 0.0;
+            lo = fmin(lo, d);
+            hi = fmax(hi, d);
+        }
+    }
+    double r = lo / hi;
+    return L->is_ll ? r * r : r;
+}
+
+/* One numeric factorisation of T T' + beta I; *rcond gets the estimate
+ * (0 when CHOLMOD found the matrix not positive definite). */
+static int factor_once(tk_nnls *s, const cholmod_sparse *T, cholmod_factor *L, double beta,
+                       double *rcond, tk_error *err)
+{
+    double b[2] = {beta, 0.0};
+    cholmod_factorize_p((cholmod_sparse *)T, b, NULL, 0, L, &s->cc);
+    if (s->cc.status < CHOLMOD_OK)
+        return cholmod_failure(s, "factorize", err);
+    *rcond = s->cc.status == CHOLMOD_NOT_POSDEF ? 0.0 : factor_rcond(L);
+    return TK_OK;
+}
+
+/* Factors T T' (= the scaled A_F^T A_F, unit diagonal), with
+ * delta I added when needed: first with delta_min (0: none), then, when
+ * may_regularise, with delta growing by NNLS_DELTA_GROWTH from
+ * NNLS_DELTA_FIRST up to NNLS_DELTA_CAP until the estimate clears the
+ * floor.  Without may_regularise a singular matrix sets f->singular and
+ * is not an error. */
+static int factor_normal(tk_nnls *s, const cholmod_sparse *T, double delta_min,
+                         bool may_regularise, double rcond_floor, nnls_factor *f,
+                         tk_error *err)
+{
+    uint64_t h = pattern_hash(T);
+    nnls_slot *slot = slot_find(s, T, h);
+    int rc = TK_OK;
+    if (!slot && (rc = slot_fill(s, T, h, &slot, err)) != TK_OK)
+        return rc;
+    slot->used = ++s->clock;
+    f->L = slot->L;
+    f->singular = false;
+    double delta = delta_min;
+    for (;;) {
+        double est = 0.0;
+        if ((rc = factor_once(s, T, slot->L, delta, &est, err)) != TK_OK)
+            return rc;
+        f->factorisations++;
+        if (delta == 0.0)
+            f->rcond = est;
+        if (est > 0.0 && est >= rcond_floor) {
+            f->delta = delta;
+            return TK_OK;
+        }
+        if (!may_regularise) {
+            f->singular = true;
+            return TK_OK;
+        }
+        delta = delta == 0.0 ? NNLS_DELTA_FIRST : delta * NNLS_DELTA_GROWTH;
+        if (delta > NNLS_DELTA_CAP * 1.000001)
+            break;
+    }
+    return tk_error_set(err, TK_ENUMERIC,
+                        "nnls: the normal equations (%zu columns) stay singular with a "
+                        "regularisation of %g times their diagonal",
+                        T->nrow, NNLS_DELTA_CAP);
+}
+
+/* Solves L-system for rhs (n entries), result in s->X. */
+static int factor_solve(tk_nnls *s, cholmod_factor *L, double *rhs, size_t n,
+                        const double **out, tk_error *err)
+{
+    cholmod_dense B;
+    memset(&B, 0, sizeof B);
+    B.nrow = n;
+    B.ncol = 1;
+    B.nzmax = n;
+    B.d = n;
+    B.x = rhs;
+    B.xtype = CHOLMOD_REAL;
+    B.dtype = CHOLMOD_DOUBLE;
+    if (!cholmod_solve2(CHOLMOD_A, L, &B, NULL, &s->X, NULL, &s->Y, &s->E, &s->cc) ||
+        s->cc.status < CHOLMOD_OK)
+        return cholmod_failure(s, "solve", err);
+    *out = s->X->x;
+    return TK_OK;
+}
+
+/* z = (T T' + delta I)^{-1} c, with `refine` steps of refinement whose
+ * residual c - T (T' z) - delta z comes from T itself.  w (m entries) and
+ * res (nrow entries) are workspace. */
+static int normal_solve(tk_nnls *s, const cholmod_sparse *T, const nnls_factor *f,
+                        const double *c, double *z, double *w, double *res, int refine,
+                        tk_error *err)
+{
+    size_t nf = T->nrow;
+    const double *sol;
+    memcpy(res, c, nf * sizeof *res);
+    int rc = factor_solve(s, f->L, res, nf, &sol, err);
+    if (rc != TK_OK)
+        return rc;
+    memcpy(z, sol, nf * sizeof *z);
+    for (int step = 0; step < refine; step++) {
+        t_transpose_times(T, z, w);
+        t_times(T, w, res);
+        for (size_t q = 0; q < nf; q++)
+            res[q] = c[q] - res[q] - f->delta * z[q];
+        if ((rc = factor_solve(s, f->L, res, nf, &sol, err)) != TK_OK)
+            return rc;
+        for (size_t q = 0; q < nf; q++)
+            z[q] += sol[q];
+    }
+    return TK_OK;
+}
+
+/* ------------------------------------------------------------------ */
+/* The public interface. */
+
+int tk_nnls_new(tk_nnls **out, tk_error *err)
+{
+    if (!out)
+        return tk_error_set(err, TK_EINVAL, "nnls: no output pointer");
+    *out = NULL;
+    tk_nnls *s = calloc(1, sizeof *s);
+    if (!s)
+        return tk_error_set(err, TK_ENOMEM, "out of memory");
+    if (!cholmod_start(&s->cc)) {
+        free(s);
+        return tk_error_set(err, TK_ENOMEM, "CHOLMOD could not start");
+    }
+    /* the library never prints; failures come back through status */
+    s->cc.print = 0;
+    s->cc.error_handler = NULL;
+    *out = s;
+    return TK_OK;
+}
+
+void tk_nnls_free(tk_nnls **p)
+{
+    if (!p || !*p)
+        return;
+    tk_nnls *s = *p;
+    for (int k = 0; k < NNLS_SLOTS; k++)
+        slot_clear(s, &s->slot[k]);
+    cholmod_free_dense(&s->X, &s->cc);
+    cholmod_free_dense(&s->Y, &s->cc);
+    cholmod_free_dense(&s->E, &s->cc);
+    cholmod_finish(&s->cc);
+    free(s);
+    *p = NULL;
+}
+
+cholmod_common *tk_nnls_common(tk_nnls *s)
+{
+    return s ? &s->cc : NULL;
+}
+
+static size_t matrix_nnz(const cholmod_sparse *A)
+{
+    size_t nnz = 0;
+    for (size_t j = 0; j < A->ncol; j++) {
+        size_t lo, hi;
+        col_span(A, j, &lo, &hi);
+        nnz += hi - lo;
+    }
+    return nnz;
+}
+
+/* The state of one tk_nnls_solve call. */
+typedef struct nnls_work {
+    tk_nnls *s;
+    const cholmod_sparse *A;
+    const double *b;
+    size_t m, n;
+    double tolb;          /* tolerance times ||b|| */
+    double rcond_floor;
+    int max_iter;
+    double *colnorm;      /* s_i = ||a_i|| */
+    double *inv_norm;     /* 1 / s_i, 0 for zero columns */
+    double *y;            /* A^T (A x - b) */
+    double *r;            /* A x - b (m) */
+    double *c, *zq, *res; /* per passive variable: rhs, solution, workspace */
+    double *trial;        /* n: Lawson-Hanson's unconstrained solution */
+    double *best;         /* n: the iterate with fewest violations */
+    int *F;               /* passive indices, increasing */
+    int *next;            /* m: workspace of build_transpose */
+    bool *passive;
+    bool *blocked;        /* Lawson-Hanson: columns not to add again yet */
+    cholmod_sparse *T;    /* A_F^T, scaled */
+    double delta_mode;    /* regularisation every later solve gets */
+    tk_nnls_report rep;
+} nnls_work;
+
+static void work_free(nnls_work *w)
+{
+    if (w->T)
+        cholmod_free_sparse(&w->T, &w->s->cc);
+    free(w->colnorm);
+    free(w->inv_norm);
+    free(w->y);
+    free(w->r);
+    free(w->c);
+    free(w->zq);
+    free(w->res);
+    free(w->trial);
+    free(w->best);
+    free(w->F);
+    free(w->next);
+    free(w->passive);
+    free(w->blocked);
+}
+
+static int work_alloc(nnls_work *w, tk_error *err)
+{
+    size_t n = w->n, m = w->m ? w->m : 1;
+    w->colnorm = malloc(n * sizeof *w->colnorm);
+    w->inv_norm = malloc(n * sizeof *w->inv_norm);
+    w->y = malloc(n * sizeof *w->y);
+    w->r = malloc(m * sizeof *w->r);
+    w->c = malloc(n * sizeof *w->c);
+    w->zq = malloc(n * sizeof *w->zq);
+    w->res = malloc(n * sizeof *w->res);
+    w->trial = malloc(n * sizeof *w->trial);
+    w->best = calloc(n, sizeof *w->best);
+    w->F = malloc(n * sizeof *w->F);
+    w->next = malloc(m * sizeof *w->next);
+    w->passive = calloc(n, sizeof *w->passive);
+    w->blocked = calloc(n, sizeof *w->blocked);
+    if (!w->colnorm || !w->inv_norm || !w->y || !w->r || !w->c || !w->zq || !w->res ||
+        !w->trial || !w->best || !w->F || !w->next || !w->passive || !w->blocked)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for nnls (%zu columns)", w->n);
+    w->T = cholmod_allocate_sparse(w->n, w->m, matrix_nnz(w->A), 1, 1, 0, CHOLMOD_REAL,
+                                   &w->s->cc);
+    if (!w->T)
+        return cholmod_failure(w->s, "allocate", err);
+    const double *Ax = w->A->x;
+    for (size_t i = 0; i < n; i++) {
+        size_t lo, hi;
+        col_span(w->A, i, &lo, &hi);
+        w->colnorm[i] = hi > lo ? norm2(Ax + lo, hi - lo) : 0.0;
+        w->inv_norm[i] = w->colnorm[i] > 0.0 ? 1.0 / w->colnorm[i] : 0.0;
+    }
+    return TK_OK;
+}
+
+/* The unconstrained least-squares solution on the passive set into out
+ * (n entries, 0 off the set).  may_regularise: see factor_normal; when a
+ * singular set may not be regularised, *singular is set and out is left
+ * alone. */
+static int passive_solve(nnls_work *w, bool may_regularise, bool *singular, double *out,
+                         tk_error *err)
+{
+    size_t nf = 0;
+    for (size_t i = 0; i < w->n; i++)
+        if (w->passive[i])
+            w->F[nf++] = (int)i;
+    *singular = false;
+    if (nf == 0) {
+        memset(out, 0, w->n * sizeof *out);
+        return TK_OK;
+    }
+    /* in the scaled variables zq_q = s_i x_i the normal matrix has a unit
+     * diagonal */
+    build_transpose(w->A, w->F, nf, w->inv_norm, w->T, w->next);
+    nnls_factor f = {NULL, 0.0, 1.0, 0, false};
+    int rc = factor_normal(w->s, w->T, may_regularise ? w->delta_mode : 0.0, may_regularise,
+                           w->rcond_floor, &f, err);
+    w->rep.factorisations += f.factorisations;
+    w->rep.rcond = fmin(w->rep.rcond, f.rcond);
+    if (rc != TK_OK)
+        return rc;
+    if (f.singular) {
+        *singular = true;
+        return TK_OK;
+    }
+    if (f.delta > 0.0) {
+        w->delta_mode = f.delta;
+        w->rep.regularised = true;
+        w->rep.regularisation = fmax(w->rep.regularisation, f.delta);
+    }
+    t_times(w->T, w->b, w->c);
+    /* a second refinement step when regularised: the system is then as
+     * ill-conditioned as 1 / delta */
+    rc = normal_solve(w->s, w->T, &f, w->c, w->zq, w->r, w->res, f.delta > 0.0 ? 2 : 1, err);
+    if (rc != TK_OK)
+        return rc;
+    memset(out, 0, w->n * sizeof *out);
+    for (size_t q = 0; q < nf; q++)
+        out[w->F[q]] = w->zq[q] * w->inv_norm[w->F[q]];
+    return TK_OK;
+}
+
+/* r = A x - b and y = A^T r (for every column, or only the active ones
+ * with y = 0 on the passive set, as block pivoting defines it). */
+static void gradient(nnls_work *w, const double *x, bool active_only)
+{
+    const int *Ai = w->A->i;
+    const double *Ax = w->A->x;
+    for (size_t k = 0; k < w->m; k++)
+        w->r[k] = -w->b[k];
+    for (size_t i = 0; i < w->n; i++) {
+        if (x[i] == 0.0)
+            continue;
+        size_t lo, hi;
+        col_span(w->A, i, &lo, &hi);
+        for (size_t e = lo; e < hi; e++)
+            w->r[Ai[e]] += Ax[e] * x[i];
+    }
+    for (size_t i = 0; i < w->n; i++)
+        w->y[i] = active_only && w->passive[i] ? 0.0 : col_dot(w->A, i, w->r);
+}
+
+/* Whether variable i is infeasible, in the scale-free sense above. */
+static bool infeasible(const nnls_work *w, const double *x, size_t i)
+{
+    double si = w->colnorm[i];
+    if (si == 0.0)
+        return false;
+    return w->passive[i] ? si * x[i] < -w->tolb : w->y[i] / si < -w->tolb;
+}
+
+/* Block principal pivoting from x = 0.  *converged tells whether it
+ * finished; it gives up early (to Lawson-Hanson) when the backup rule is
+ * needed on a regularised (rank-deficient) problem, where single pivots
+ * were seen to wander for thousands of steps, or has run for
+ * NNLS_BACKUP_STEPS(n) steps. */
+#define NNLS_BACKUP_STEPS(n) (20 + (n) / 4)
+
+static int block_pivoting(nnls_work *w, double *x, bool *converged, tk_error *err)
+{
+    size_t n = w->n;
+    size_t best_count = SIZE_MAX;   /* fewest infeasible seen */
+    size_t bar = SIZE_MAX;          /* Kim and Park's beta */
+    int budget = NNLS_FULL_EXCHANGE_BUDGET;
+    size_t backup_steps = 0;
+    *converged = false;
+    memset(x, 0, n * sizeof *x);
+    gradient(w, x, true);
+    for (;;) {
+        size_t ninf = 0, last = 0;
+        for (size_t i = 0; i < n; i++)
+            if (infeasible(w, x, i)) {
+                ninf++;
+                last = i;
+            }
+        if (ninf < best_count) {
+            best_count = ninf;
+            memcpy(w->best, x, n * sizeof *x);
+        }
+        if (ninf == 0) {
+            *converged = true;
+            return TK_OK;
+        }
+        if (w->rep.iterations >= w->max_iter)
+            return TK_OK;
+        bool backup = false;
+        if (ninf < bar) {
+            bar = ninf;
+            budget = NNLS_FULL_EXCHANGE_BUDGET;
+        } else if (budget > 0) {
+            budget--;
+        } else {
+            backup = true;
+        }
+        if (backup) {
+            if (w->delta_mode > 0.0 || backup_steps >= NNLS_BACKUP_STEPS(n))
+                return TK_OK;
+            /* only the infeasible variable of largest index changes side */
+            backup_steps++;
+            w->rep.used_fallback = true;
+            w->passive[last] = !w->passive[last];
+        } else {
+            for (size_t i = 0; i < n; i++)
+                if (infeasible(w, x, i))
+                    w->passive[i] = !w->passive[i];
+        }
+        w->rep.iterations++;
+        bool singular;
+        int rc = passive_solve(w, true, &singular, x, err);
+        if (rc != TK_OK)
+            return rc;
+        gradient(w, x, true);
+    }
+}
+
+/* Lawson and Hanson's inner loop: moves x towards the least-squares
+ * solution on the passive set, dropping the variables that reach zero,
+ * until that solution is positive.  t is the column just added (SIZE_MAX
+ * for none): when it leaves again without any step taken, the loop stops
+ * with *progress false.  *singular: the passive columns are dependent to
+ * working precision (x is then unchanged by the last attempt). */
+static int lh_inner(nnls_work *w, double *x, size_t t, bool *progress, bool *singular,
+                    tk_error *err)
+{
+    size_t n = w->n;
+    *progress = false;
+    for (;;) {
+        int rc = passive_solve(w, false, singular, w->trial, err);
+        if (rc != TK_OK || *singular)
+            return rc;
+        /* the longest step from x towards trial that stays feasible */
+        double alpha = 1.0;
+        size_t hit = SIZE_MAX;
+        for (size_t i = 0; i < n; i++)
+            if (w->passive[i] && w->trial[i] <= 0.0) {
+                double a = x[i] / (x[i] - w->trial[i]);
+                if (a < alpha) {
+                    alpha = a;
+                    hit = i;
+                }
+            }
+        if (hit == SIZE_MAX) {
+            memcpy(x, w->trial, n * sizeof *x);
+            *progress = true;
+            return TK_OK;
+        }
+        if (alpha > 0.0)
+            *progress = true;
+        for (size_t i = 0; i < n; i++)
+            if (w->passive[i]) {
+                x[i] += alpha * (w->trial[i] - x[i]);
+                if (i == hit || x[i] <= 0.0) {
+                    x[i] = 0.0;
+                    w->passive[i] = false;
+                }
+            }
+        if (t != SIZE_MAX && !w->passive[t] && !*progress)
+            return TK_OK;
+    }
+}
+
+/* Lawson and Hanson's active-set method: columns join the passive set one
+ * at a time (the most violating first) and leave it when a step towards
+ * the unconstrained solution would make them negative, so every iterate
+ * is feasible, the objective falls and the passive columns stay
+ * independent (a column whose addition makes the normal equations
+ * singular is blocked until the next step makes progress).  Slower than
+ * block pivoting, but it needs no regularisation and does not cycle on
+ * rank-deficient or degenerate problems.  It starts from x (feasible,
+ * e.g. block pivoting's best iterate clamped at 0) when the support of x
+ * has independent columns, otherwise from 0. */
+static int lawson_hanson(nnls_work *w, double *x, bool *converged, tk_error *err)
+{
+    size_t n = w->n;
+    bool progress, singular;
+    *converged = false;
+    memset(w->blocked, 0, n * sizeof *w->blocked);
+    for (size_t i = 0; i < n; i++) {
+        if (!(x[i] > 0.0) || w->colnorm[i] == 0.0)
+            x[i] = 0.0;
+        w->passive[i] = x[i] > 0.0;
+    }
+    int rc = lh_inner(w, x, SIZE_MAX, &progress, &singular, err);
+    if (rc != TK_OK)
+        return rc;
+    if (singular) {
+        memset(x, 0, n * sizeof *x);
+        memset(w->passive, 0, n * sizeof *w->passive);
+    }
+    gradient(w, x, false);
+    for (;;) {
+        size_t t = SIZE_MAX;
+        double most = -w->tolb;
+        for (size_t i = 0; i < n; i++) {
+            if (w->passive[i] || w->blocked[i] || w->colnorm[i] == 0.0)
+                continue;
+            double v = w->y[i] / w->colnorm[i];
+            if (v < most) {
+                most = v;
+                t = i;
+            }
+        }
+        if (t == SIZE_MAX) {
+            *converged = true;
+            return TK_OK;
+        }
+        if (w->rep.iterations >= w->max_iter)
+            return TK_OK;
+        w->rep.iterations++;
+        w->passive[t] = true;
+        if ((rc = lh_inner(w, x, t, &progress, &singular, err)) != TK_OK)
+            return rc;
+        if (singular) {
+            /* t depends on the passive columns to working precision */
+            w->passive[t] = false;
+            progress = false;
+        }
+        if (progress)
+            memset(w->blocked, 0, n * sizeof *w->blocked);
+        else
+            w->blocked[t] = true;
+        gradient(w, x, false);
+    }
+}
+
+int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *x,
+                  const tk_nnls_options *opts, tk_nnls_report *report, tk_error *err)
+{
+    tk_nnls_options o = TK_NNLS_OPTIONS_INIT;
+    nnls_work w;
+    memset(&w, 0, sizeof w);
+    w.rep = (tk_nnls_report){0, 0, false, false, 0.0, 1.0, 0.0, 0};
+    int rc = TK_OK;
+
+    if (!s)
+        return tk_error_set(err, TK_EINVAL, "nnls: no solver");
+    if ((rc = check_matrix(A, err)) != TK_OK)
+        return rc;
+    size_t m = A->nrow, n = A->ncol;
+    if ((rc = check_vector(b, m, "b", err)) != TK_OK)
+        return rc;
+    if (n > 0 && !x)
+        return tk_error_set(err, TK_EINVAL, "nnls: no x vector");
+    if (opts)
+        o = *opts;
+    w.s = s;
+    w.A = A;
+    w.b = b;
+    w.m = m;
+    w.n = n;
+    w.max_iter = o.max_iterations > 0 ? o.max_iterations
+                 : (n > (size_t)(INT_MAX / 4) ? INT_MAX : 50 + 2 * (int)n);
+    w.rcond_floor = o.rcond_floor >= 0.0 ? o.rcond_floor : NNLS_DEFAULT_RCOND_FLOOR;
+    double tol = o.kkt_tolerance > 0.0 ? o.kkt_tolerance : NNLS_DEFAULT_TOLERANCE;
+
+    for (size_t i = 0; i < n; i++)
+        x[i] = 0.0;
+    double bnorm = norm2(b, m);
+    w.rep.residual = bnorm;
+    w.tolb = tol * bnorm;
+    /* x = 0 is optimal for b = 0, and nothing is to be solved for n = 0 */
+    if (n == 0 || bnorm == 0.0)
+        goto done;
+    if ((rc = work_alloc(&w, err)) != TK_OK)
+        goto done;
+
+    /* the iteration cap is shared: Lawson-Hanson gets what block pivoting
+     * left */
+    bool converged = false, lh = false;
+    rc = block_pivoting(&w, x, &converged, err);
+    if (rc == TK_OK && !converged && w.rep.iterations < w.max_iter) {
+        w.rep.used_fallback = true;
+        lh = true;
+        memcpy(x, w.best, n * sizeof *x);
+        rc = lawson_hanson(&w, x, &converged, err);
+    }
+    if (rc == TK_OK && !converged)
+        rc = tk_error_set(err, TK_ENUMERIC, "nnls: no solution after %d pivoting iterations",
+                          w.rep.iterations);
+    /* Lawson-Hanson's iterates are feasible and improve; otherwise keep
+     * block pivoting's best */
+    if (rc != TK_OK && !lh)
+        memcpy(x, w.best, n * sizeof *x);
+    /* within tolerance is feasible: the answer is exactly non-negative */
+    for (size_t i = 0; i < n; i++)
+        if (!(x[i] > 0.0))
+            x[i] = 0.0;
+    gradient(&w, x, true);
+    w.rep.residual = norm2(w.r, m);
+    for (size_t i = 0; i < n; i++)
+        w.rep.passive += x[i] > 0.0;
+
+done:
+    if (report)
+        *report = w.rep;
+    work_free(&w);
+    return rc;
+}
+
+int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, double *du,
+                     double *delta_used, tk_error *err)
+{
+    int rc = TK_OK;
+    int *F = NULL, *next = NULL;
+    double *c = NULL, *z = NULL, *res = NULL, *inv_norm = NULL;
+    cholmod_sparse *T = NULL;
+
+    if (delta_used)
+        *delta_used = 0.0;
+    if (!s)
+        return tk_error_set(err, TK_EINVAL, "nnls: no solver");
+    if ((rc = check_matrix(A, err)) != TK_OK)
+        return rc;
+    size_t m = A->nrow, n = A->ncol;
+    if ((rc = check_vector(r, n, "r", err)) != TK_OK)
+        return rc;
+    if (m > 0 && !du)
+        return tk_error_set(err, TK_EINVAL, "nnls: no du vector");
+    for (size_t k = 0; k < m; k++)
+        du[k] = 0.0;
+    if (n == 0 || m == 0)
+        return TK_OK;
+
+    F = malloc(n * sizeof *F);
+    next = malloc(m * sizeof *next);
+    c = malloc(n * sizeof *c);
+    z = malloc(n * sizeof *z);
+    res = malloc(n * sizeof *res);
+    inv_norm = malloc(n * sizeof *inv_norm);
+    if (!F || !next || !c || !z || !res || !inv_norm) {
+        rc = tk_error_set(err, TK_ENOMEM, "out of memory for min-norm (%zu columns)", n);
+        goto done;
+    }
+    /* zero columns add nothing to A y; leaving them out keeps A^T A from
+     * being singular for no reason (their rows of A^T du = r cannot hold
+     * unless r is 0 there) */
+    size_t nf = 0;
+    const double *Ax = A->x;
+    for (size_t i = 0; i < n; i++) {
+        size_t lo, hi;
+        col_span(A, i, &lo, &hi);
+        double si = hi > lo ? norm2(Ax + lo, hi - lo) : 0.0;
+        inv_norm[i] = si > 0.0 ? 1.0 / si : 0.0;
+        if (si > 0.0) {
+            /* scaled: A D^-1 y' = du with (D^-1 A^T A D^-1) y' = D^-1 r */
+            c[nf] = r[i] * inv_norm[i];
+            F[nf++] = (int)i;
+        }
+    }
+    if (nf == 0)
+        goto done;
+    T = cholmod_allocate_sparse(n, m, matrix_nnz(A), 1, 1, 0, CHOLMOD_REAL, &s->cc);
+    if (!T) {
+        rc = cholmod_failure(s, "allocate", err);
+        goto done;
+    }
+    build_transpose(A, F, nf, inv_norm, T, next);
+    nnls_factor f = {NULL, 0.0, 1.0, 0, false};
+    if ((rc = factor_normal(s, T, 0.0, true, NNLS_DEFAULT_RCOND_FLOOR, &f, err)) != TK_OK)
+        goto done;
+    if ((rc = normal_solve(s, T, &f, c, z, du, res, f.delta > 0.0 ? 2 : 1, err)) != TK_OK)
+        goto done;
+    t_transpose_times(T, z, du);
+    if (delta_used)
+        *delta_used = f.delta;
+
+done:
+    if (rc != TK_OK)
+        for (size_t k = 0; k < m; k++)
+            du[k] = 0.0;
+    cholmod_free_sparse(&T, &s->cc);
+    free(F);
+    free(next);
+    free(c);
+    free(z);
+    free(res);
+    free(inv_norm);
+    return rc;
+}

@@ -1,0 +1,739 @@
+#include "tk/tighten.h"
+
+#include <math.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "tk/geometry.h"
+#include "tk/nnls.h"
+#include "tk/rigidity.h"
+#include "tk/thickness.h"
+
+/* Step sizes below this fraction of the largest allowed count as no step;
+ * this many of them in a row stop the run as stalled. */
+#define STALL_FRACTION 1e-12
+#define STALL_STEPS 20
+#define MAX_HALVINGS 50
+#define MAX_CORRECTIONS 25
+
+struct tk_run {
+    tk_options opt;
+    double tau;          /* the tube diameter, 2 radius */
+    double min_radius;   /* lambda * radius: the bound on minrad */
+    tk_curve *curve;
+    tk_curve *trial;
+    tk_strut_finder *finder;
+    tk_nnls *nnls;
+    bool *fixed;         /* per vertex: end points of open components */
+    double *grad;        /* 3V: gradient of length */
+    double *motion;      /* 3V: the motion, then the resolved motion */
+    double *work;        /* 3V */
+    double *x;           /* compressions, one per constraint */
+    double *rhs;         /* one per constraint */
+    size_t constraint_capacity;
+    tk_strut_list struts;
+    tk_kink *kinks;
+    size_t nkinks;
+    tk_step_report latest;
+    tk_step_report *history;
+    size_t nhistory, history_capacity;
+    double *snapshots;
+    long *snapshot_steps;
+    size_t nsnapshots, snapshot_capacity;
+    double step_size;
+    int tiny_steps;
+    double started;
+    tk_stop_reason stop;
+    atomic_int cancel;
+    tk_progress_fn progress;
+    void *user;
+};
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+const char *tk_stop_reason_name(tk_stop_reason r)
+{
+    switch (r) {
+    case TK_STOP_NONE: return "running";
+    case TK_STOP_STEPS: return "steps";
+    case TK_STOP_TIME: return "time";
+    case TK_STOP_RESIDUAL: return "residual";
+    case TK_STOP_CHANGE: return "change";
+    case TK_STOP_CANCELLED: return "cancelled";
+    case TK_STOP_STALLED: return "stalled";
+    case TK_STOP_FAILED: return "failed";
+    }
+    return "unknown";
+}
+
+static int check_options(const tk_options *o, tk_error *err)
+{
+    if (!(o->radius > 0.0) || !isfinite(o->radius))
+        return tk_error_set(err, TK_EINVAL, "radius must be a positive number (got %g)", o->radius);
+    if (!(o->lambda > 0.0) || !isfinite(o->lambda))
+        return tk_error_set(err, TK_EINVAL, "lambda must be a positive number (got %g)", o->lambda);
+    if (!(o->resolution >= 0.0) || o->resolution > 1e4)
+        return tk_error_set(err, TK_EINVAL, "resolution must be between 0 and 10000 (got %g)",
+                            o->resolution);
+    if (o->autoscale && !(o->autoscale_margin >= 1.0 && o->autoscale_margin < 2.0))
+        return tk_error_set(err, TK_EINVAL, "autoscale margin must be in [1, 2) (got %g)",
+                            o->autoscale_margin);
+    if (o->max_steps < 0 || !(o->max_seconds >= 0.0) || !(o->min_residual >= 0.0) ||
+        !(o->min_change >= 0.0))
+        return tk_error_set(err, TK_EINVAL, "stop criteria must not be negative");
+    if (!(o->active_tolerance > 0.0 && o->active_tolerance < 0.5) ||
+        !(o->overstep_tolerance > 0.0 && o->overstep_tolerance < 0.1) ||
+        !(o->correction_tolerance > 0.0 && o->correction_tolerance < o->overstep_tolerance))
+        return tk_error_set(err, TK_EINVAL,
+                            "tolerances must satisfy 0 < correction < overstep < 0.1 and "
+                            "0 < active < 0.5");
+    if (!(o->equalise >= 0.0) || !isfinite(o->equalise))
+        return tk_error_set(err, TK_EINVAL, "equalise gain must be >= 0");
+    return TK_OK;
+}
+
+void tk_run_free(tk_run **p)
+{
+    if (!p || !*p)
+        return;
+    tk_run *r = *p;
+    tk_curve_free(&r->curve);
+    tk_curve_free(&r->trial);
+    tk_strut_finder_free(&r->finder);
+    tk_nnls_free(&r->nnls);
+    free(r->fixed);
+    free(r->grad);
+    free(r->motion);
+    free(r->work);
+    free(r->x);
+    free(r->rhs);
+    tk_strut_list_free(&r->struts);
+    free(r->kinks);
+    free(r->history);
+    free(r->snapshots);
+    free(r->snapshot_steps);
+    free(r);
+    *p = NULL;
+}
+
+/* The thickness of the starting curve, for set-up. */
+static int measure(const tk_curve *c, tk_measure *m, tk_error *err)
+{
+    int rc = tk_thickness_measure(c, NULL, m, err);
+    if (rc == TK_OK && !(m->thickness > 0.0 && isfinite(m->thickness)))
+        rc = tk_error_set(err, TK_EINVAL,
+                          "the curve has no finite thickness (%g): nothing to tighten",
+                          m->thickness);
+    return rc;
+}
+
+static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
+{
+    tk_measure m;
+    int rc = tk_curve_copy(start, &r->curve, err);
+    if (!rc)
+        rc = measure(r->curve, &m, err);
+    if (rc)
+        return rc;
+    if (r->opt.resolution > 0.0) {
+        double want = ceil(r->opt.resolution * m.ropelength);
+        if (want > 1e7)
+            return tk_error_set(err, TK_ELIMIT,
+                                "resolution %g at ropelength %.4g asks for %.0f vertices",
+                                r->opt.resolution, m.ropelength, want);
+        tk_curve *resampled = NULL;
+        rc = tk_curve_resample_total(r->curve, (size_t)want, &resampled, err);
+        if (rc)
+            return rc;
+        tk_curve_free(&r->curve);
+        r->curve = resampled;
+        rc = measure(r->curve, &m, err);
+        if (rc)
+            return rc;
+    }
+    if (r->opt.autoscale) {
+        tk_curve_scale(r->curve, r->opt.autoscale_margin * r->tau / m.thickness);
+    } else if (m.thickness < r->tau * (1.0 - r->opt.overstep_tolerance) ||
+               2.0 * m.minrad < 2.0 * r->min_radius * (1.0 - r->opt.overstep_tolerance)) {
+        return tk_error_set(err, TK_EINVAL,
+                            "the curve's thickness %.6g is below the tube diameter %.6g "
+                            "(or its curvature too high for lambda %g): use autoscale",
+                            m.thickness, r->tau, r->opt.lambda);
+    }
+    return TK_OK;
+}
+
+static int grow_constraints(tk_run *r, size_t n, tk_error *err)
+{
+    if (n <= r->constraint_capacity)
+        return TK_OK;
+    size_t cap = r->constraint_capacity ? r->constraint_capacity : 64;
+    while (cap < n)
+        cap *= 2;
+    double *x = realloc(r->x, cap * sizeof *x);
+    if (x)
+        r->x = x;
+    double *rhs = realloc(r->rhs, cap * sizeof *rhs);
+    if (rhs)
+        r->rhs = rhs;
+    if (!x || !rhs)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for %zu constraints", n);
+    r->constraint_capacity = cap;
+    return TK_OK;
+}
+
+/* Active constraints of the run's curve (the finder must be fitted to it). */
+static int find_active(tk_run *r, const tk_curve *c, tk_error *err)
+{
+    tk_strut_list_clear(&r->struts);
+    free(r->kinks);
+    r->kinks = NULL;
+    r->nkinks = 0;
+    double slack = 1.0 + r->opt.active_tolerance;
+    int rc = tk_strut_finder_find(r->finder, c, TK_ARC_ADMISSIBLE, r->tau, r->tau * slack,
+                                  &r->struts, err);
+    if (!rc)
+        rc = tk_kinks_find(c, 2.0 * r->min_radius * slack, &r->kinks, &r->nkinks, err);
+    if (!rc)
+        rc = grow_constraints(r, r->struts.count + r->nkinks, err);
+    return rc;
+}
+
+/* The rigidity matrix of the active constraints, with the rows of fixed
+ * vertices zeroed: those coordinates are not variables. */
+static int build_matrix(tk_run *r, const tk_curve *c, cholmod_sparse **a, tk_error *err)
+{
+    int rc = tk_rigidity_build(c, r->struts.items, r->struts.count, r->kinks, r->nkinks,
+                               tk_nnls_common(r->nnls), a, err);
+    if (rc)
+        return rc;
+    const int *colp = (*a)->p, *row = (*a)->i;
+    double *val = (*a)->x;
+    for (int k = 0; k < colp[(*a)->ncol]; k++)
+        if (r->fixed[row[k] / 3])
+            val[k] = 0.0;
+    return TK_OK;
+}
+
+static void free_matrix(tk_run *r, cholmod_sparse **a)
+{
+    if (*a)
+        cholmod_free_sparse(a, tk_nnls_common(r->nnls));
+}
+
+/* out = A x (3V entries). */
+static void multiply(const cholmod_sparse *a, const double *x, double *out, size_t rows)
+{
+    memset(out, 0, rows * sizeof *out);
+    const int *colp = a->p, *row = a->i;
+    const double *val = a->x;
+    for (size_t j = 0; j < a->ncol; j++)
+        for (int k = colp[j]; k < colp[j + 1]; k++)
+            out[row[k]] += val[k] * x[j];
+}
+
+static double norm(const double *v, size_t n)
+{
+    double s = 0.0;
+    for (size_t i = 0; i < n; i++)
+        s += v[i] * v[i];
+    return sqrt(s);
+}
+
+/* Section 4.2: a velocity along each vertex's tangent proportional to how
+ * far the vertex is from its share of the component's length, so that the
+ * edges even out.  Scaled to the mean size of the length gradient so the
+ * two motions keep their proportion as the curve tightens. */
+static void add_equalising_motion(tk_run *r, const tk_curve *c, double *u)
+{
+    size_t nv = c->nvert;
+    double mean_grad = 0.0;
+    for (size_t v = 0; v < nv; v++)
+        mean_grad += norm(r->grad + 3 * v, 3);
+    mean_grad /= (double)(nv ? nv : 1);
+    if (!(r->opt.equalise > 0.0) || !(mean_grad > 0.0))
+        return;
+    for (size_t comp = 0; comp < c->ncomp; comp++) {
+        size_t n = tk_curve_comp_vertices(c, comp), ne = tk_curve_comp_edges(c, comp);
+        double total = tk_curve_comp_length(c, comp), mean_edge = total / (double)ne;
+        double *offset = r->work; /* n entries suffice: 3V >= n */
+        double arc = 0.0, shift = 0.0;
+        for (size_t k = 0; k < n; k++) {
+            offset[k] = total * (double)k / (double)ne - arc;
+            shift += offset[k];
+            if (k < ne)
+                arc += tk_curve_edge_length(c, comp, k);
+        }
+        /* A closed component's vertices may all slide together: only their
+         * spacing matters. */
+        shift = c->closed[comp] ? shift / (double)n : 0.0;
+        for (size_t k = 0; k < n; k++) {
+            size_t v = c->offset[comp] + k;
+            if (r->fixed[v] || (!c->closed[comp] && (k == 0 || k + 1 == n)))
+                continue;
+            size_t before = c->closed[comp] ? (k + n - 1) % n : k - 1;
+            const double *prev = tk_curve_vertex(c, c->offset[comp] + before);
+            const double *next = tk_curve_vertex(c, tk_curve_vertex_index(c, comp, k + 1));
+            double t[3] = {next[0] - prev[0], next[1] - prev[1], next[2] - prev[2]};
+            double tn = norm(t, 3);
+            if (!(tn > 0.0))
+                continue;
+            double speed = r->opt.equalise * mean_grad * (offset[k] - shift) / mean_edge;
+            for (int j = 0; j < 3; j++)
+                u[3 * v + j] += speed * t[j] / tn;
+        }
+    }
+}
+
+/* Worst violation of the constraints by curve c, as a fraction of the
+ * bound: (tau - closest admissible pair) / tau and
+ * (lambda r - minrad) / (lambda r).  0 when all hold.  The finder must be
+ * fitted to c. */
+static int violation(tk_run *r, const tk_curve *c, double *out, tk_error *err)
+{
+    double closest;
+    int rc = tk_strut_finder_closest_pair(r->finder, c, TK_ARC_ADMISSIBLE, r->tau, r->tau,
+                                          &closest, err);
+    if (rc)
+        return rc;
+    double minrad = tk_curve_minrad(c, NULL);
+    double v = fmax((r->tau - closest) / r->tau, (r->min_radius - minrad) / r->min_radius);
+    *out = fmax(v, 0.0);
+    return TK_OK;
+}
+
+/* Section 4.6: Newton steps du solving A^T du = -R with minimum norm, R the
+ * violations of the active constraints (0 for those that hold, so they
+ * stay put to first order), until every violation is below the correction
+ * tolerance.  Each step is damped until the worst violation falls (near-
+ * dependent constraints can make the regularised solution long); rescaling
+ * about the centroid is the last resort, for small leftovers only.  On
+ * return the finder is fitted to the curve. */
+static int correct(tk_run *r, int *iterations, tk_error *err)
+{
+    tk_curve *c = r->curve, *t = r->trial;
+    size_t n3 = 3 * c->nvert;
+    int rc = TK_OK;
+    *iterations = 0;
+    tk_strut_finder_refit(r->finder, c);
+    double worst;
+    rc = violation(r, c, &worst, err);
+    for (int it = 0; !rc && worst > r->opt.correction_tolerance && it < MAX_CORRECTIONS; it++) {
+        rc = find_active(r, c, err);
+        if (rc)
+            return rc;
+        size_t ns = r->struts.count, ncon = ns + r->nkinks;
+        if (ncon == 0)
+            break;
+        /* Aim a little inside the feasible set so rounding does not leave
+         * the constraint just violated. */
+        double aim = 0.5 * r->opt.correction_tolerance;
+        for (size_t j = 0; j < ns; j++) {
+            double g = r->struts.items[j].length - r->tau;
+            r->rhs[j] = g < 0.0 ? -g + aim * r->tau : 0.0;
+        }
+        for (size_t k = 0; k < r->nkinks; k++) {
+            double g = r->kinks[k].minrad - r->min_radius;
+            r->rhs[ns + k] = g < 0.0 ? -g + aim * r->min_radius : 0.0;
+        }
+        cholmod_sparse *a = NULL;
+        rc = build_matrix(r, c, &a, err);
+        if (rc)
+            return rc;
+        double delta = 0.0;
+        rc = tk_nnls_min_norm(r->nnls, a, r->rhs, r->motion, &delta, err);
+        free_matrix(r, &a);
+        if (rc)
+            return rc;
+        /* Never move a vertex by more than a tenth of the diameter. */
+        double longest = 0.0;
+        for (size_t v = 0; v < c->nvert; v++)
+            longest = fmax(longest, norm(r->motion + 3 * v, 3));
+        double alpha = longest > 0.1 * r->tau ? 0.1 * r->tau / longest : 1.0;
+        bool improved = false;
+        for (int halving = 0; halving < 12 && !improved; halving++, alpha *= 0.5) {
+            for (size_t i = 0; i < n3; i++)
+                t->xyz[i] = c->xyz[i] + alpha * r->motion[i];
+            tk_strut_finder_refit(r->finder, t);
+            double trial_worst;
+            rc = violation(r, t, &trial_worst, err);
+            if (rc)
+                return rc;
+            if (trial_worst < worst) {
+                memcpy(c->xyz, t->xyz, n3 * sizeof *c->xyz);
+                worst = trial_worst;
+                improved = true;
+            }
+        }
+        tk_strut_finder_refit(r->finder, c);
+        (*iterations)++;
+        if (!improved)
+            break;
+    }
+    if (rc || worst <= r->opt.correction_tolerance)
+        return rc;
+    if (worst > 10.0 * r->opt.overstep_tolerance)
+        return tk_error_set(err, TK_ENUMERIC,
+                            "could not restore the thickness: constraints violated by %.3g of "
+                            "the diameter after %d corrections",
+                            worst, *iterations);
+    /* Scale up about the centroid, which raises every distance and radius
+     * in proportion: the small leftover violation goes away. */
+    double centre[3], back[3];
+    tk_curve_centroid(c, centre);
+    for (int k = 0; k < 3; k++) {
+        back[k] = centre[k];
+        centre[k] = -centre[k];
+    }
+    tk_curve_translate(c, centre);
+    tk_curve_scale(c, 1.0 / (1.0 - worst) * (1.0 + 0.5 * r->opt.correction_tolerance));
+    tk_curve_translate(c, back);
+    tk_strut_finder_refit(r->finder, c);
+    return TK_OK;
+}
+
+static int record(tk_run *r, tk_step_report *rep, tk_error *err)
+{
+    tk_measure m;
+    int rc = tk_thickness_measure(r->curve, r->finder, &m, err);
+    if (rc)
+        return rc;
+    rep->length = m.length;
+    rep->thickness = m.thickness;
+    rep->minrad = m.minrad;
+    rep->ropelength = m.ropelength;
+    rep->vertices = r->curve->nvert;
+    rep->seconds = now_seconds() - r->started;
+    if (r->nhistory == r->history_capacity) {
+        size_t cap = r->history_capacity ? 2 * r->history_capacity : 256;
+        tk_step_report *grown = realloc(r->history, cap * sizeof *grown);
+        if (!grown)
+            return tk_error_set(err, TK_ENOMEM, "out of memory for the history");
+        r->history = grown;
+        r->history_capacity = cap;
+    }
+    r->history[r->nhistory++] = *rep;
+    r->latest = *rep;
+    if (r->opt.snapshot_every > 0 && rep->step % (long)r->opt.snapshot_every == 0) {
+        size_t nv3 = 3 * r->curve->nvert;
+        if (r->nsnapshots == r->snapshot_capacity) {
+            size_t cap = r->snapshot_capacity ? 2 * r->snapshot_capacity : 16;
+            double *grown = realloc(r->snapshots, cap * nv3 * sizeof *grown);
+            if (grown)
+                r->snapshots = grown;
+            long *steps = realloc(r->snapshot_steps, cap * sizeof *steps);
+            if (steps)
+                r->snapshot_steps = steps;
+            if (!grown || !steps)
+                return tk_error_set(err, TK_ENOMEM, "out of memory for snapshots");
+            r->snapshot_capacity = cap;
+        }
+        memcpy(r->snapshots + r->nsnapshots * nv3, r->curve->xyz, nv3 * sizeof(double));
+        r->snapshot_steps[r->nsnapshots++] = rep->step;
+    }
+    return TK_OK;
+}
+
+int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_error *err)
+{
+    *out = NULL;
+    tk_options defaults = TK_OPTIONS_INIT;
+    if (!opts)
+        opts = &defaults;
+    int rc = check_options(opts, err);
+    if (rc)
+        return rc;
+    tk_run *r = calloc(1, sizeof *r);
+    if (!r)
+        return tk_error_set(err, TK_ENOMEM, "out of memory");
+    r->opt = *opts;
+    r->tau = 2.0 * opts->radius;
+    r->min_radius = opts->lambda * opts->radius;
+    atomic_init(&r->cancel, 0);
+    r->started = now_seconds();
+    rc = prepare_curve(r, start, err);
+    if (!rc)
+        rc = tk_curve_copy(r->curve, &r->trial, err);
+    if (!rc)
+        rc = tk_strut_finder_new(r->curve, &r->finder, err);
+    if (!rc)
+        rc = tk_nnls_new(&r->nnls, err);
+    if (rc) {
+        tk_run_free(&r);
+        return rc;
+    }
+    size_t nv = r->curve->nvert;
+    r->fixed = calloc(nv, sizeof *r->fixed);
+    r->grad = calloc(3 * nv, sizeof *r->grad);
+    r->motion = calloc(3 * nv, sizeof *r->motion);
+    r->work = calloc(3 * nv, sizeof *r->work);
+    if (!r->fixed || !r->grad || !r->motion || !r->work) {
+        tk_run_free(&r);
+        return tk_error_set(err, TK_ENOMEM, "out of memory for a run of %zu vertices", nv);
+    }
+    for (size_t comp = 0; comp < r->curve->ncomp; comp++)
+        if (!r->curve->closed[comp]) {
+            r->fixed[r->curve->offset[comp]] = true;
+            r->fixed[r->curve->offset[comp + 1] - 1] = true;
+        }
+    int corrections = 0;
+    rc = correct(r, &corrections, err);
+    if (!rc)
+        rc = find_active(r, r->curve, err);
+    tk_step_report rep = {0};
+    rep.rcond = 1.0;
+    rep.residual = NAN;
+    rep.corrections = corrections;
+    rep.struts = r->struts.count;
+    rep.kinks = r->nkinks;
+    if (!rc)
+        rc = violation(r, r->curve, &rep.violation, err);
+    if (!rc)
+        rc = record(r, &rep, err);
+    if (rc) {
+        tk_run_free(&r);
+        return rc;
+    }
+    *out = r;
+    return TK_OK;
+}
+
+void tk_run_set_progress(tk_run *r, tk_progress_fn fn, void *user)
+{
+    r->progress = fn;
+    r->user = user;
+}
+
+void tk_run_cancel(tk_run *r)
+{
+    atomic_store(&r->cancel, 1);
+}
+
+/* Resolves the motion against the active constraints (equation 13):
+ * motion = u + A x with x >= 0 minimising |A x + u|. */
+static int resolve(tk_run *r, tk_step_report *rep, tk_error *err)
+{
+    tk_curve *c = r->curve;
+    size_t n3 = 3 * c->nvert;
+    tk_curve_length_gradient(c, r->grad);
+    for (size_t v = 0; v < c->nvert; v++)
+        if (r->fixed[v])
+            r->grad[3 * v] = r->grad[3 * v + 1] = r->grad[3 * v + 2] = 0.0;
+    for (size_t i = 0; i < n3; i++)
+        r->motion[i] = -r->grad[i];
+    add_equalising_motion(r, c, r->motion);
+    size_t ns = r->struts.count, ncon = ns + r->nkinks;
+    double grad_norm = norm(r->grad, n3);
+    rep->rcond = 1.0;
+    if (ncon == 0) {
+        rep->residual = grad_norm > 0.0 ? 1.0 : 0.0;
+        return TK_OK;
+    }
+    cholmod_sparse *a = NULL;
+    int rc = build_matrix(r, c, &a, err);
+    if (rc)
+        return rc;
+    for (size_t i = 0; i < n3; i++)
+        r->work[i] = -r->motion[i];
+    tk_nnls_report nr;
+    rc = tk_nnls_solve(r->nnls, a, r->work, r->x, NULL, &nr, err);
+    if (rc) {
+        free_matrix(r, &a);
+        return rc;
+    }
+    rep->rcond = nr.rcond;
+    multiply(a, r->x, r->work, n3);
+    free_matrix(r, &a);
+    for (size_t i = 0; i < n3; i++)
+        r->motion[i] += r->work[i];
+    /* The residual of the length gradient alone, with the same forces. */
+    double s = 0.0;
+    for (size_t i = 0; i < n3; i++) {
+        double d = -r->grad[i] + r->work[i];
+        s += d * d;
+    }
+    rep->residual = grad_norm > 0.0 ? sqrt(s) / grad_norm : 0.0;
+    for (size_t j = 0; j < ns; j++)
+        r->struts.items[j].force = r->x[j];
+    for (size_t k = 0; k < r->nkinks; k++)
+        r->kinks[k].force = r->x[ns + k];
+    return TK_OK;
+}
+
+/* Section 4.5: the largest step, halving from twice the last one, whose
+ * end point violates no constraint by more than the overstep tolerance.
+ * Returns the step taken (0 if none was acceptable). */
+static int take_step(tk_run *r, tk_step_report *rep, tk_error *err)
+{
+    tk_curve *c = r->curve, *t = r->trial;
+    size_t n3 = 3 * c->nvert;
+    double fastest = 0.0;
+    for (size_t v = 0; v < c->nvert; v++)
+        fastest = fmax(fastest, norm(r->motion + 3 * v, 3));
+    if (!(fastest > 0.0)) {
+        rep->step_size = 0.0;
+        return TK_OK;
+    }
+    /* No vertex moves more than a tenth of the diameter or a quarter of the
+     * shortest edge in one step, so no strand can pass through another
+     * between two checks and no edge folds over. */
+    double shortest_edge;
+    tk_curve_edge_range(c, &shortest_edge, NULL);
+    double largest = fmin(0.1 * r->tau, 0.25 * shortest_edge) / fastest;
+    double h = r->step_size > 0.0 ? fmin(2.0 * r->step_size, largest) : largest / 8.0;
+    for (int halving = 0; halving < MAX_HALVINGS; halving++, h *= 0.5) {
+        for (size_t i = 0; i < n3; i++)
+            t->xyz[i] = c->xyz[i] + h * r->motion[i];
+        tk_strut_finder_refit(r->finder, t);
+        double worst;
+        int rc = violation(r, t, &worst, err);
+        if (rc)
+            return rc;
+        if (worst <= r->opt.overstep_tolerance) {
+            memcpy(c->xyz, t->xyz, n3 * sizeof *c->xyz);
+            r->step_size = h;
+            rep->step_size = h;
+            r->tiny_steps = h < STALL_FRACTION * largest ? r->tiny_steps + 1 : 0;
+            return TK_OK;
+        }
+    }
+    tk_strut_finder_refit(r->finder, c);
+    rep->step_size = 0.0;
+    r->step_size = 0.0;
+    r->tiny_steps++;
+    return TK_OK;
+}
+
+static void check_stop(tk_run *r)
+{
+    const tk_options *o = &r->opt;
+    const tk_step_report *s = &r->latest;
+    if (atomic_load(&r->cancel))
+        r->stop = TK_STOP_CANCELLED;
+    else if (o->max_steps > 0 && s->step >= o->max_steps)
+        r->stop = TK_STOP_STEPS;
+    else if (o->max_seconds > 0.0 && s->seconds >= o->max_seconds)
+        r->stop = TK_STOP_TIME;
+    else if (o->min_residual > 0.0 && s->residual < o->min_residual)
+        r->stop = TK_STOP_RESIDUAL;
+    else if (o->min_change > 0.0 && o->change_window > 0 && r->nhistory > o->change_window) {
+        double before = r->history[r->nhistory - 1 - o->change_window].ropelength;
+        if ((before - s->ropelength) / s->ropelength < o->min_change)
+            r->stop = TK_STOP_CHANGE;
+    }
+    if (r->stop == TK_STOP_NONE && r->tiny_steps >= STALL_STEPS)
+        r->stop = TK_STOP_STALLED;
+}
+
+int tk_run_step(tk_run *r, tk_error *err)
+{
+    if (r->stop == TK_STOP_FAILED)
+        return tk_error_set(err, TK_EINVAL, "the run has failed; it cannot step");
+    if (atomic_load(&r->cancel)) {
+        r->stop = TK_STOP_CANCELLED;
+        return TK_OK;
+    }
+    tk_step_report rep = {0};
+    rep.step = r->latest.step + 1;
+    tk_strut_finder_refit(r->finder, r->curve);
+    int rc = find_active(r, r->curve, err);
+    if (!rc)
+        rc = resolve(r, &rep, err);
+    if (!rc)
+        rc = take_step(r, &rep, err);
+    double worst = 0.0;
+    if (!rc)
+        rc = violation(r, r->curve, &worst, err);
+    if (!rc && worst > 0.5 * r->opt.overstep_tolerance)
+        rc = correct(r, &rep.corrections, err);
+    if (!rc)
+        rc = violation(r, r->curve, &rep.violation, err);
+    rep.struts = r->struts.count;
+    rep.kinks = r->nkinks;
+    if (!rc)
+        rc = record(r, &rep, err);
+    if (rc) {
+        r->stop = TK_STOP_FAILED;
+        return rc;
+    }
+    if (r->progress && r->progress(&r->latest, r->user) != 0)
+        tk_run_cancel(r);
+    r->stop = TK_STOP_NONE;
+    check_stop(r);
+    return TK_OK;
+}
+
+int tk_run_until(tk_run *r, tk_stop_reason *reason, tk_error *err)
+{
+    int rc = TK_OK;
+    if (r->stop != TK_STOP_FAILED)
+        r->stop = TK_STOP_NONE;
+    check_stop(r);
+    while (r->stop == TK_STOP_NONE) {
+        rc = tk_run_step(r, err);
+        if (rc)
+            break;
+    }
+    if (reason)
+        *reason = r->stop;
+    return rc;
+}
+
+const tk_options *tk_run_options(const tk_run *r)
+{
+    return &r->opt;
+}
+
+const tk_curve *tk_run_curve(const tk_run *r)
+{
+    return r->curve;
+}
+
+const tk_step_report *tk_run_latest(const tk_run *r)
+{
+    return &r->latest;
+}
+
+const tk_step_report *tk_run_history(const tk_run *r, size_t *count)
+{
+    *count = r->nhistory;
+    return r->history;
+}
+
+const tk_strut *tk_run_struts(const tk_run *r, size_t *count)
+{
+    *count = r->struts.count;
+    return r->struts.items;
+}
+
+const tk_kink *tk_run_kinks(const tk_run *r, size_t *count)
+{
+    *count = r->nkinks;
+    return r->kinks;
+}
+
+tk_stop_reason tk_run_stop_reason(const tk_run *r)
+{
+    return r->stop;
+}
+
+size_t tk_run_snapshot_count(const tk_run *r)
+{
+    return r->nsnapshots;
+}
+
+const double *tk_run_snapshot(const tk_run *r, size_t k, long *step)
+{
+    if (k >= r->nsnapshots)
+        return NULL;
+    if (step)
+        *step = r->snapshot_steps[k];
+    return r->snapshots + k * 3 * r->curve->nvert;
+}

@@ -1,0 +1,78 @@
+/* tightknot: sparse non-negative least squares (equation 13).
+ *
+ *     minimise || A x - b ||  subject to  x >= 0
+ *
+ * A is m x n sparse (CHOLMOD, real, unsymmetric); in the flow m = 3V
+ * coordinates, n = active constraints, b = -(motion), and x are the strut
+ * and kink compressions.  Solved by block principal pivoting (Portugal,
+ * Judice and Vicente; Kim and Park): each iteration solves the
+ * unconstrained least-squares problem on the current passive set by sparse
+ * Cholesky of the normal equations, A_F^T A_F x_F = A_F^T b, and exchanges
+ * every variable that violates the KKT conditions at once; when the number
+ * of violations stops falling the exchange falls back to the single-variable
+ * rule (Murty's), which always terminates.
+ *
+ * Rank-deficient or ill-conditioned A is normal in the flow (symmetric
+ * starts, many contacts).  The solver estimates the reciprocal condition
+ * number of each factorisation (CHOLMOD's estimate), and when a
+ * factorisation fails or is too ill-conditioned it adds a small Tikhonov
+ * term (A^T A + delta I), reported in tk_nnls_report.
+ *
+ * A tk_nnls owns its cholmod_common and workspace: one per thread.  It keeps
+ * the symbolic analysis between calls and reuses it when the passive set's
+ * pattern repeats.
+ */
+#ifndef TK_NNLS_H
+#define TK_NNLS_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include <cholmod.h>
+
+#include "tk/error.h"
+
+typedef struct tk_nnls tk_nnls;
+
+typedef struct tk_nnls_options {
+    int max_iterations;     /* outer pivoting iterations; default 50 + 2n */
+    double kkt_tolerance;   /* relative tolerance on the KKT tests; 1e-10 */
+    double rcond_floor;     /* regularise factorisations below this; 1e-14 */
+} tk_nnls_options;
+
+#define TK_NNLS_OPTIONS_INIT {0, 1e-10, 1e-14}
+
+typedef struct tk_nnls_report {
+    int iterations;         /* pivoting iterations */
+    int factorisations;     /* Cholesky factorisations done */
+    bool used_fallback;     /* the single-variable exchange rule was needed */
+    bool regularised;       /* a Tikhonov term was added */
+    double regularisation;  /* the largest delta used (0 if none) */
+    double rcond;           /* smallest reciprocal condition estimate seen
+                               (of A_F^T A_F; 1 when no column is passive) */
+    double residual;        /* || A x - b || at the answer */
+    size_t passive;         /* number of x_i > 0 */
+} tk_nnls_report;
+
+/* A solver with its own CHOLMOD common.  Never prints. */
+int tk_nnls_new(tk_nnls **out, tk_error *err);
+void tk_nnls_free(tk_nnls **p);
+
+/* The solver's cholmod_common, for allocating matrices passed to it. */
+cholmod_common *tk_nnls_common(tk_nnls *s);
+
+/* Solves the NNLS problem.  A is m x n (A->stype == 0, packed, real); b has
+ * m entries; x receives n entries.  opts may be NULL for the defaults;
+ * report may be NULL.  Returns TK_OK, or TK_ENUMERIC when no answer
+ * satisfying x >= 0 could be produced (x then holds the best found). */
+int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *x,
+                  const tk_nnls_options *opts, tk_nnls_report *report, tk_error *err);
+
+/* The minimum-norm solution du (m entries) of the underdetermined system
+ * A^T du = r (r has n entries), du = A y with (A^T A + delta I) y = r,
+ * delta = 0 unless the factorisation needs it (then *delta_used > 0).
+ * Used for error recovery (section 4.6). */
+int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, double *du,
+                     double *delta_used, tk_error *err);
+
+#endif

@@ -1,0 +1,134 @@
+/* tightknot: the tightening flow (sections 3 and 4 of the paper).
+ *
+ * A run owns a copy of the curve and everything a step needs (strut tree,
+ * NNLS solver with its CHOLMOD common, work vectors), so runs in different
+ * threads share nothing.  Each step:
+ *   1. active constraints: struts within tau (1 + active_tolerance) among
+ *      Theorem 3's admissible pairs, and kinks (vertices whose minrad is
+ *      within the same tolerance of lambda * radius);
+ *   2. the motion u = -grad(length) (equation 14) plus a tangential motion
+ *      that evens out the edges (section 4.2);
+ *   3. the rigidity matrix A (equations 6, 7) and the NNLS problem
+ *      min ||A x + u||, x >= 0 (equation 13); the resolved motion is
+ *      u + A x (Proposition 3), x the compressions;
+ *   4. the step: halving from twice the last step size until the error it
+ *      introduces into every constraint (contacts that become active
+ *      mid-step included, found again with the tree) is within the
+ *      overstep tolerance (section 4.5);
+ *   5. error recovery: while some constraint is violated beyond the
+ *      correction tolerance, Newton steps with the minimum-norm solution of
+ *      A^T du = -R (section 4.6); rescaling only if that fails.
+ * Open components keep their end points fixed.
+ *
+ * Thread safety: a run is used by one thread at a time, except
+ * tk_run_cancel, which any thread may call at any time.
+ */
+#ifndef TK_TIGHTEN_H
+#define TK_TIGHTEN_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "tk/curve.h"
+#include "tk/error.h"
+#include "tk/struts.h"
+
+typedef struct tk_options {
+    double radius;               /* tube radius; the diameter tau is 2 radius */
+    double lambda;               /* stiffness: minrad >= lambda * radius */
+    double resolution;           /* re-resolve to ceil(resolution * ropelength)
+                                    vertices at the start; 0 keeps the input */
+    bool autoscale;              /* scale so thickness = autoscale_margin * tau */
+    double autoscale_margin;
+    /* Stop criteria; 0 leaves one unused.  The run stops at the first met. */
+    long max_steps;
+    double max_seconds;
+    double min_residual;         /* stop when residual < this */
+    double min_change;           /* stop when ropelength fell by less than
+                                    this (relative) over change_window steps */
+    size_t change_window;
+    /* Tolerances, relative to the diameter tau. */
+    double active_tolerance;     /* constraints this close are active */
+    double overstep_tolerance;   /* largest violation a step may introduce */
+    double correction_tolerance; /* violations above this are corrected */
+    double equalise;             /* gain of the edge-equalising motion */
+    size_t snapshot_every;       /* keep the curve every K steps (0: never) */
+} tk_options;
+
+#define TK_OPTIONS_INIT                                                                  \
+    {                                                                                    \
+        0.5, 1.0, 0.0, false, 1.002, 0, 0.0, 0.0, 0.0, 20, 1e-3, 1e-4, 1e-5, 0.5, 0      \
+    }
+
+/* Why a run stopped. */
+typedef enum tk_stop_reason {
+    TK_STOP_NONE = 0,      /* still running */
+    TK_STOP_STEPS,
+    TK_STOP_TIME,
+    TK_STOP_RESIDUAL,
+    TK_STOP_CHANGE,
+    TK_STOP_CANCELLED,
+    TK_STOP_STALLED,       /* the step size fell to nothing */
+    TK_STOP_FAILED         /* numerical failure: see the error message */
+} tk_stop_reason;
+
+const char *tk_stop_reason_name(tk_stop_reason r);
+
+/* The figures of one step (also the run's history). */
+typedef struct tk_step_report {
+    long step;               /* 1 for the first step; 0 for the start */
+    double seconds;          /* wall time since the run started */
+    double ropelength;       /* 2 length / thickness (Definition 1) */
+    double length;
+    double thickness;        /* Definition 1 */
+    double minrad;
+    double residual;         /* |-grad L + A x| / |grad L| */
+    size_t struts;           /* active struts */
+    size_t kinks;            /* active kinks */
+    double step_size;        /* h of the step taken */
+    double rcond;            /* NNLS condition estimate (1 without constraints) */
+    double violation;        /* worst constraint violation after the step / tau */
+    int corrections;         /* Newton iterations after the step */
+    size_t vertices;
+} tk_step_report;
+
+typedef struct tk_run tk_run;
+
+/* Called after every step with that step's figures; a non-zero return
+ * cancels the run. */
+typedef int (*tk_progress_fn)(const tk_step_report *step, void *user);
+
+/* Creates a run from a copy of `start`, applying re-resolution and
+ * autoscale.  Fails (TK_EINVAL) when the start is not a valid curve, or is
+ * thinner than the tube and autoscale is off. */
+int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_error *err);
+void tk_run_free(tk_run **p);
+
+void tk_run_set_progress(tk_run *r, tk_progress_fn fn, void *user);
+
+/* One step.  Returns TK_OK, or an error (the run is then stopped with
+ * TK_STOP_FAILED and the curve is the last good one). */
+int tk_run_step(tk_run *r, tk_error *err);
+
+/* Steps until a stop criterion is met; *reason says which. */
+int tk_run_until(tk_run *r, tk_stop_reason *reason, tk_error *err);
+
+/* Asks the run to stop; it does within one step.  Thread-safe. */
+void tk_run_cancel(tk_run *r);
+
+const tk_options *tk_run_options(const tk_run *r);
+const tk_curve *tk_run_curve(const tk_run *r);
+/* The latest figures (step 0 before the first step). */
+const tk_step_report *tk_run_latest(const tk_run *r);
+const tk_step_report *tk_run_history(const tk_run *r, size_t *count);
+/* Active struts and kinks of the last step, with their NNLS forces. */
+const tk_strut *tk_run_struts(const tk_run *r, size_t *count);
+const tk_kink *tk_run_kinks(const tk_run *r, size_t *count);
+tk_stop_reason tk_run_stop_reason(const tk_run *r);
+
+/* Snapshots: the vertex coordinates (3 * vertices doubles, same component
+ * layout as tk_run_curve) every snapshot_every steps. */
+size_t tk_run_snapshot_count(const tk_run *r);
+const double *tk_run_snapshot(const tk_run *r, size_t k, long *step);
+
+#endif
