@@ -55,7 +55,7 @@ BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
 .SECONDARY:
 
-.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts \
+.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten \
 	lint headers clean
 
 all: $(LIB) $(CLI)
@@ -101,10 +101,13 @@ run: deps all
 	@echo "on http://127.0.0.1:8080/ once it exists.  Meanwhile try:"
 	@echo "  $(CLI) info $(CATALOGUE)/3.1.vect"
 
-bench: bench-struts
+bench: bench-struts bench-tighten
 
 bench-struts: deps all $(BENCH_BIN)
 	$(Q)$(BUILD)/bench/struts $(CATALOGUE)
+
+bench-tighten: deps all $(BENCH_BIN)
+	$(Q)$(BUILD)/bench/tighten $(CATALOGUE)
 
 # Banned unsafe calls (curl's list).
 lint:

@@ -13,22 +13,32 @@
  * only the infeasible variable of largest index changes side (Murty's rule,
  * Judice and Pires), which terminates for a positive definite A^T A.
  *
+ * A^T A is only semi-definite when n > m or columns are dependent, and
+ * then the pivoting can stall (seen: thousands of single pivots without
+ * progress).  So the backup rule gets NNLS_BACKUP_STEPS steps, and after
+ * that, or at once when a passive set had to be regularised, Lawson and
+ * Hanson's active-set method takes over from the best iterate; see
+ * tk_nnls_solve.  The header calls both "the fallback".
+ *
  * Tolerances are scale-free: with s_i = ||a_i||, x_i is infeasible when
  * s_i x_i < -tol ||b|| and y_i when y_i / s_i < -tol ||b||; both sides are
  * in units of b, so scaling a column or b changes nothing.  Zero columns
  * never enter F (any x_i is optimal for them; 0 is returned).
  *
- * The unconstrained subproblems use the normal equations.  With
- * T = A_F^T (n_F x m, built here column by column from A), CHOLMOD's
- * unsymmetric mode factors T T' + beta I = A_F^T A_F + beta I directly, so
- * M = A_F^T A_F is never stored.  The symbolic analysis depends only on
- * T's pattern, which is kept (a copy of it) with the factor in a small
- * least-recently-used cache; a solve of the same problem pattern (the
- * passive-set sequence from x = 0 repeats from one flow step to the next)
- * re-uses the analyses.  Each solve is followed by a step of iterative
- * refinement whose residual is formed from T, not from the factor
- * (corrected semi-normal equations), which wins back most of the accuracy
- * lost to the squared condition number.
+ * The unconstrained subproblems use the normal equations of the columns
+ * scaled to unit norm (variables z_i = s_i x_i), so that the normal matrix
+ * M = D^-1 A_F^T A_F D^-1 has a unit diagonal: the condition estimate and
+ * the regularisation below then do not depend on how the columns are
+ * scaled.  With T = (A_F D^-1)^T (n_F x m, built here from A), CHOLMOD's
+ * unsymmetric mode factors T T' + delta I = M + delta I directly, so M is
+ * never stored.  The symbolic analysis depends only on T's pattern, which
+ * is kept (a copy of it) with the factor in a small least-recently-used
+ * cache: a repeat solve with the same pattern of A (the passive-set
+ * sequence from x = 0 repeats from one flow step to the next) re-uses the
+ * analyses.  Each solve is followed by a step of iterative refinement
+ * whose residual is formed from T, not from the factor (corrected
+ * semi-normal equations), which wins back most of the accuracy lost to the
+ * squared condition number.
  *
  * Condition: the estimate is the ratio of the smallest to the largest pivot
  * of the factorisation, (min L_jj / max L_jj)^2 for LL' (supernodal) and
@@ -38,9 +48,16 @@
  * The scan is done here because a simplicial LDL' factorisation of a
  * singular or indefinite M "succeeds" with zero or negative pivots, which
  * CHOLMOD does not flag; such a factor reports 0.  When the estimate is
- * below rcond_floor (or CHOLMOD reports the matrix not positive
- * definite), the factorisation is repeated with beta = delta * max(diag M),
- * delta = 1e-12, 1e-10, ..., 1e-2, until the estimate clears the floor.
+ * below rcond_floor (or CHOLMOD reports the matrix not positive definite),
+ * the factorisation is repeated with delta = 1e-12, 1e-10, ..., 1e-2 added
+ * to M's unit diagonal (in the unscaled variables: A_F^T A_F + delta D^2)
+ * until the estimate clears the floor.  NNLS_TIKHONOV_STEPS steps of
+ * iterated Tikhonov regularisation with that factor then take the bias
+ * of delta out again (see normal_solve), so the residual is that of the
+ * unregularised least-squares problem on F.  Once some passive set needed
+ * a delta, every later one in the same solve starts from that delta
+ * (which saves a failing factorisation each time, the columns being
+ * dependent) and the backup rule hands over to Lawson and Hanson at once.
  */
 #include "tk/nnls.h"
 
@@ -56,6 +73,7 @@
 #define NNLS_DELTA_FIRST 1e-12
 #define NNLS_DELTA_GROWTH 100.0
 #define NNLS_DELTA_CAP 1e-2
+#define NNLS_TIKHONOV_STEPS 3
 #define NNLS_DEFAULT_TOLERANCE 1e-10
 #define NNLS_DEFAULT_RCOND_FLOOR 1e-14
 
@@ -360,12 +378,12 @@ static double factor_rcond(const cholmod_factor *L)
     return L->is_ll ? r * r : r;
 }
 
-/* One numeric factorisation of T T' + beta I; *rcond gets the estimate
+/* One numeric factorisation of T T' + delta I; *rcond gets the estimate
  * (0 when CHOLMOD found the matrix not positive definite). */
-static int factor_once(tk_nnls *s, const cholmod_sparse *T, cholmod_factor *L, double beta,
+static int factor_once(tk_nnls *s, const cholmod_sparse *T, cholmod_factor *L, double delta,
                        double *rcond, tk_error *err)
 {
-    double b[2] = {beta, 0.0};
+    double b[2] = {delta, 0.0};
     cholmod_factorize_p((cholmod_sparse *)T, b, NULL, 0, L, &s->cc);
     if (s->cc.status < CHOLMOD_OK)
         return cholmod_failure(s, "factorize", err);
@@ -417,7 +435,7 @@ static int factor_normal(tk_nnls *s, const cholmod_sparse *T, double delta_min,
                         T->nrow, NNLS_DELTA_CAP);
 }
 
-/* Solves L-system for rhs (n entries), result in s->X. */
+/* Solves with the factor for rhs (n entries); *out points into s->X. */
 static int factor_solve(tk_nnls *s, cholmod_factor *L, double *rhs, size_t n,
                         const double **out, tk_error *err)
 {
@@ -438,12 +456,18 @@ static int factor_solve(tk_nnls *s, cholmod_factor *L, double *rhs, size_t n,
 }
 
 /* z = (T T' + delta I)^{-1} c, with `refine` steps of refinement whose
- * residual c - T (T' z) - delta z comes from T itself.  w (m entries) and
+ * residual c - T (T' z) - delta z comes from T itself.  With
+ * `unregularised`, the residual leaves out delta z: the steps are then
+ * iterated Tikhonov regularisation, which converge to the minimum-norm
+ * solution of T T' z = c when c is in the range of T (each step shrinks
+ * the error along an eigenvalue lambda by delta / (lambda + delta)), and
+ * so take the bias of the regularisation out of T' z.  w (m entries) and
  * res (nrow entries) are workspace. */
 static int normal_solve(tk_nnls *s, const cholmod_sparse *T, const nnls_factor *f,
                         const double *c, double *z, double *w, double *res, int refine,
-                        tk_error *err)
+                        bool unregularised, tk_error *err)
 {
+    double delta = unregularised ? 0.0 : f->delta;
     size_t nf = T->nrow;
     const double *sol;
     memcpy(res, c, nf * sizeof *res);
@@ -455,7 +479,7 @@ static int normal_solve(tk_nnls *s, const cholmod_sparse *T, const nnls_factor *
         t_transpose_times(T, z, w);
         t_times(T, w, res);
         for (size_t q = 0; q < nf; q++)
-            res[q] = c[q] - res[q] - f->delta * z[q];
+            res[q] = c[q] - res[q] - delta * z[q];
         if ((rc = factor_solve(s, f->L, res, nf, &sol, err)) != TK_OK)
             return rc;
         for (size_t q = 0; q < nf; q++)
@@ -482,6 +506,14 @@ int tk_nnls_new(tk_nnls **out, tk_error *err)
     /* the library never prints; failures come back through status */
     s->cc.print = 0;
     s->cc.error_handler = NULL;
+    /* The flow's normal matrices are small and very sparse: the simplicial
+     * factorisation is as fast, and it keeps CHOLMOD's BLAS and OpenMP
+     * threads out of runs that already have a thread each.  One ordering
+     * (AMD) instead of trying several. */
+    s->cc.supernodal = CHOLMOD_SIMPLICIAL;
+    s->cc.nmethods = 1;
+    s->cc.method[0].ordering = CHOLMOD_AMD;
+    s->cc.postorder = 0;
     *out = s;
     return TK_OK;
 }
@@ -630,9 +662,13 @@ static int passive_solve(nnls_work *w, bool may_regularise, bool *singular, doub
         w->rep.regularisation = fmax(w->rep.regularisation, f.delta);
     }
     t_times(w->T, w->b, w->c);
-    /* a second refinement step when regularised: the system is then as
-     * ill-conditioned as 1 / delta */
-    rc = normal_solve(w->s, w->T, &f, w->c, w->zq, w->r, w->res, f.delta > 0.0 ? 2 : 1, err);
+    /* When regularised, c = T b is in the range of T, so iterated Tikhonov
+     * steps recover the least-squares solution (of minimum norm, up to
+     * rounding along the null space, which does not change A x): the
+     * residual is then that of the unregularised problem, not one
+     * inflated by delta. */
+    rc = normal_solve(w->s, w->T, &f, w->c, w->zq, w->r, w->res,
+                      f.delta > 0.0 ? NNLS_TIKHONOV_STEPS : 1, true, err);
     if (rc != TK_OK)
         return rc;
     memset(out, 0, w->n * sizeof *out);
@@ -670,22 +706,38 @@ static bool infeasible(const nnls_work *w, const double *x, size_t i)
     return w->passive[i] ? si * x[i] < -w->tolb : w->y[i] / si < -w->tolb;
 }
 
-/* Block principal pivoting from x = 0.  *converged tells whether it
- * finished; it gives up early (to Lawson-Hanson) when the backup rule is
- * needed on a regularised (rank-deficient) problem, where single pivots
- * were seen to wander for thousands of steps, or has run for
- * NNLS_BACKUP_STEPS(n) steps. */
-#define NNLS_BACKUP_STEPS(n) (20 + (n) / 4)
+/* Block principal pivoting from x = 0, or from the least-squares solution
+ * on the passive set `guess` (NULL for none).  *converged tells whether it
+ * finished.  It gives up (to Lawson and Hanson) when the backup rule has
+ * run NNLS_BACKUP_STEPS times without finishing, or at once when the
+ * backup rule is needed after a passive set needed regularising: with a
+ * singular A^T A the problem is only positive semi-definite, and single
+ * pivots were seen to wander for thousands of steps. */
+#define NNLS_BACKUP_STEPS 10
 
-static int block_pivoting(nnls_work *w, double *x, bool *converged, tk_error *err)
+static int block_pivoting(nnls_work *w, double *x, const bool *guess, bool *converged,
+                          tk_error *err)
 {
     size_t n = w->n;
     size_t best_count = SIZE_MAX;   /* fewest infeasible seen */
     size_t bar = SIZE_MAX;          /* Kim and Park's beta */
     int budget = NNLS_FULL_EXCHANGE_BUDGET;
-    size_t backup_steps = 0;
+    int backup_steps = 0;
+    bool singular;
+    int rc;
     *converged = false;
     memset(x, 0, n * sizeof *x);
+    memset(w->passive, 0, n * sizeof *w->passive);
+    if (guess) {
+        for (size_t i = 0; i < n; i++)
+            w->passive[i] = guess[i] && w->colnorm[i] > 0.0;
+        if ((rc = passive_solve(w, true, &singular, x, err)) != TK_OK)
+            return rc;
+        if (singular) {
+            memset(x, 0, n * sizeof *x);
+            memset(w->passive, 0, n * sizeof *w->passive);
+        }
+    }
     gradient(w, x, true);
     for (;;) {
         size_t ninf = 0, last = 0;
@@ -714,7 +766,7 @@ static int block_pivoting(nnls_work *w, double *x, bool *converged, tk_error *er
             backup = true;
         }
         if (backup) {
-            if (w->delta_mode > 0.0 || backup_steps >= NNLS_BACKUP_STEPS(n))
+            if (w->delta_mode > 0.0 || backup_steps >= NNLS_BACKUP_STEPS)
                 return TK_OK;
             /* only the infeasible variable of largest index changes side */
             backup_steps++;
@@ -726,9 +778,7 @@ static int block_pivoting(nnls_work *w, double *x, bool *converged, tk_error *er
                     w->passive[i] = !w->passive[i];
         }
         w->rep.iterations++;
-        bool singular;
-        int rc = passive_solve(w, true, &singular, x, err);
-        if (rc != TK_OK)
+        if ((rc = passive_solve(w, true, &singular, x, err)) != TK_OK)
             return rc;
         gradient(w, x, true);
     }
@@ -754,7 +804,9 @@ static int lh_inner(nnls_work *w, double *x, size_t t, bool *progress, bool *sin
         size_t hit = SIZE_MAX;
         for (size_t i = 0; i < n; i++)
             if (w->passive[i] && w->trial[i] <= 0.0) {
-                double a = x[i] / (x[i] - w->trial[i]);
+                /* x_i = trial_i = 0 (a column just added) blocks any step */
+                double d = x[i] - w->trial[i];
+                double a = d > 0.0 ? x[i] / d : 0.0;
                 if (a < alpha) {
                     alpha = a;
                     hit = i;
@@ -874,6 +926,14 @@ int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *
     w.rcond_floor = o.rcond_floor >= 0.0 ? o.rcond_floor : NNLS_DEFAULT_RCOND_FLOOR;
     double tol = o.kkt_tolerance > 0.0 ? o.kkt_tolerance : NNLS_DEFAULT_TOLERANCE;
 
+    bool *guess = NULL;
+    if (o.warm_start && n > 0) {
+        guess = malloc(n * sizeof *guess);
+        if (!guess)
+            return tk_error_set(err, TK_ENOMEM, "out of memory for nnls (%zu columns)", n);
+        for (size_t i = 0; i < n; i++)
+            guess[i] = x[i] > 0.0;
+    }
     for (size_t i = 0; i < n; i++)
         x[i] = 0.0;
     double bnorm = norm2(b, m);
@@ -885,10 +945,16 @@ int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *
     if ((rc = work_alloc(&w, err)) != TK_OK)
         goto done;
 
-    /* the iteration cap is shared: Lawson-Hanson gets what block pivoting
-     * left */
+    /* Two phases share the iteration cap.  Block pivoting solves the
+     * usual problem in a few iterations.  When it stalls (n > m, or a
+     * rank-deficient or degenerate problem), Lawson and Hanson's method
+     * takes its best iterate (clamped, so feasible) to the answer one
+     * variable at a time: from there it needs about as many steps as that
+     * iterate had violations, where from 0 it needs one per passive
+     * variable.  (Going on with block pivoting on a regularised, positive
+     * definite problem was tried and stalled the same way.) */
     bool converged = false, lh = false;
-    rc = block_pivoting(&w, x, &converged, err);
+    rc = block_pivoting(&w, x, guess, &converged, err);
     if (rc == TK_OK && !converged && w.rep.iterations < w.max_iter) {
         w.rep.used_fallback = true;
         lh = true;
@@ -915,6 +981,7 @@ done:
     if (report)
         *report = w.rep;
     work_free(&w);
+    free(guess);
     return rc;
 }
 
@@ -979,7 +1046,12 @@ int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, doubl
     nnls_factor f = {NULL, 0.0, 1.0, 0, false};
     if ((rc = factor_normal(s, T, 0.0, true, NNLS_DEFAULT_RCOND_FLOOR, &f, err)) != TK_OK)
         goto done;
-    if ((rc = normal_solve(s, T, &f, c, z, du, res, f.delta > 0.0 ? 2 : 1, err)) != TK_OK)
+    /* r need not be in the range of A^T (dependent constraints with
+     * different targets), so the refinement stays on the regularised
+     * system: iterated Tikhonov would blow its null-space part up by
+     * 1 / delta a step */
+    if ((rc = normal_solve(s, T, &f, c, z, du, res, f.delta > 0.0 ? 2 : 1, false, err)) !=
+        TK_OK)
         goto done;
     t_transpose_times(T, z, du);
     if (delta_used)

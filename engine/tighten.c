@@ -17,6 +17,8 @@
 #define STALL_STEPS 20
 #define MAX_HALVINGS 50
 #define MAX_CORRECTIONS 25
+#define MAX_EXPANSIONS 8
+#define HALVINGS_BEFORE_EXPANDING 3
 
 struct tk_run {
     tk_options opt;
@@ -36,6 +38,9 @@ struct tk_run {
     tk_strut_list struts;
     tk_kink *kinks;
     size_t nkinks;
+    tk_strut_list known_struts;  /* the last resolution's, sorted, with forces */
+    tk_kink *known_kinks;
+    size_t nknown_kinks;
     tk_step_report latest;
     tk_step_report *history;
     size_t nhistory, history_capacity;
@@ -116,6 +121,8 @@ void tk_run_free(tk_run **p)
     free(r->rhs);
     tk_strut_list_free(&r->struts);
     free(r->kinks);
+    tk_strut_list_free(&r->known_struts);
+    free(r->known_kinks);
     free(r->history);
     free(r->snapshots);
     free(r->snapshot_steps);
@@ -516,6 +523,77 @@ void tk_run_cancel(tk_run *r)
     atomic_store(&r->cancel, 1);
 }
 
+static int compare_strut_edges(const void *pa, const void *pb)
+{
+    const tk_strut *a = pa, *b = pb;
+    for (int k = 0; k < 2; k++) {
+        if (a->comp[k] != b->comp[k])
+            return a->comp[k] < b->comp[k] ? -1 : 1;
+        if (a->edge[k] != b->edge[k])
+            return a->edge[k] < b->edge[k] ? -1 : 1;
+    }
+    return 0;
+}
+
+static int compare_kink_vertices(const void *pa, const void *pb)
+{
+    const tk_kink *a = pa, *b = pb;
+    if (a->comp != b->comp)
+        return a->comp < b->comp ? -1 : 1;
+    return a->vertex < b->vertex ? -1 : (a->vertex > b->vertex ? 1 : 0);
+}
+
+/* The forces of the last resolution as the NNLS's starting guess: contacts
+ * change little from one step to the next, so the passive set does too. */
+static void guess_forces(const tk_run *r)
+{
+    size_t ns = r->struts.count;
+    for (size_t j = 0; j < ns; j++) {
+        const tk_strut *hit =
+            r->known_struts.count
+                ? bsearch(&r->struts.items[j], r->known_struts.items, r->known_struts.count,
+                          sizeof *hit, compare_strut_edges)
+                : NULL;
+        r->x[j] = hit ? hit->force : 0.0;
+    }
+    for (size_t k = 0; k < r->nkinks; k++) {
+        const tk_kink *hit = r->nknown_kinks ? bsearch(&r->kinks[k], r->known_kinks,
+                                                       r->nknown_kinks, sizeof *hit,
+                                                       compare_kink_vertices)
+                                             : NULL;
+        r->x[ns + k] = hit ? hit->force : 0.0;
+    }
+}
+
+static int remember_forces(tk_run *r, tk_error *err)
+{
+    tk_strut_list *known = &r->known_struts;
+    tk_strut_list_clear(known);
+    if (known->capacity < r->struts.count) {
+        tk_strut *grown = realloc(known->items, r->struts.count * sizeof *grown);
+        if (!grown)
+            return tk_error_set(err, TK_ENOMEM, "out of memory for struts");
+        known->items = grown;
+        known->capacity = r->struts.count;
+    }
+    if (r->struts.count)
+        memcpy(known->items, r->struts.items, r->struts.count * sizeof *known->items);
+    known->count = r->struts.count;
+    qsort(known->items, known->count, sizeof *known->items, compare_strut_edges);
+    free(r->known_kinks);
+    r->known_kinks = NULL;
+    r->nknown_kinks = 0;
+    if (r->nkinks) {
+        r->known_kinks = malloc(r->nkinks * sizeof *r->known_kinks);
+        if (!r->known_kinks)
+            return tk_error_set(err, TK_ENOMEM, "out of memory for kinks");
+        memcpy(r->known_kinks, r->kinks, r->nkinks * sizeof *r->kinks);
+        r->nknown_kinks = r->nkinks;
+        qsort(r->known_kinks, r->nknown_kinks, sizeof *r->known_kinks, compare_kink_vertices);
+    }
+    return TK_OK;
+}
+
 /* Resolves the motion against the active constraints (equation 13):
  * motion = u + A x with x >= 0 minimising |A x + u|. */
 static int resolve(tk_run *r, tk_step_report *rep, tk_error *err)
@@ -543,7 +621,10 @@ static int resolve(tk_run *r, tk_step_report *rep, tk_error *err)
     for (size_t i = 0; i < n3; i++)
         r->work[i] = -r->motion[i];
     tk_nnls_report nr;
-    rc = tk_nnls_solve(r->nnls, a, r->work, r->x, NULL, &nr, err);
+    tk_nnls_options nopt = TK_NNLS_OPTIONS_INIT;
+    nopt.warm_start = true;
+    guess_forces(r);
+    rc = tk_nnls_solve(r->nnls, a, r->work, r->x, &nopt, &nr, err);
     if (rc) {
         free_matrix(r, &a);
         return rc;
@@ -564,7 +645,109 @@ static int resolve(tk_run *r, tk_step_report *rep, tk_error *err)
         r->struts.items[j].force = r->x[j];
     for (size_t k = 0; k < r->nkinks; k++)
         r->kinks[k].force = r->x[ns + k];
-    return TK_OK;
+    return remember_forces(r, err);
+}
+
+static bool has_strut(const tk_strut_list *list, const tk_strut *s)
+{
+    for (size_t j = 0; j < list->count; j++) {
+        const tk_strut *o = &list->items[j];
+        if (o->comp[0] == s->comp[0] && o->edge[0] == s->edge[0] && o->comp[1] == s->comp[1] &&
+            o->edge[1] == s->edge[1])
+            return true;
+    }
+    return false;
+}
+
+/* A step tried to `trial` broke constraints that were not active: add them
+ * (with their values at the current curve) so the next resolution keeps
+ * them to first order.  These are the contacts that become active mid-step
+ * (section 4.5): found again with the tree at the trial point.  The finder
+ * must be fitted to `trial`.  *added counts the new constraints. */
+static int expand_active(tk_run *r, const tk_curve *trial, size_t *added, tk_error *err)
+{
+    const tk_curve *c = r->curve;
+    *added = 0;
+    double floor = 1.0 - r->opt.overstep_tolerance;
+    tk_strut_list broken = {0};
+    int rc = tk_strut_finder_find(r->finder, trial, TK_ARC_ADMISSIBLE, r->tau, r->tau * floor,
+                                  &broken, err);
+    for (size_t j = 0; !rc && j < broken.count; j++) {
+        tk_strut s = broken.items[j];
+        if (has_strut(&r->struts, &s))
+            continue;
+        tk_closest cl;
+        tk_segment_closest(tk_curve_vertex(c, tk_curve_vertex_index(c, s.comp[0], s.edge[0])),
+                           tk_curve_vertex(c, tk_curve_vertex_index(c, s.comp[0], s.edge[0] + 1)),
+                           tk_curve_vertex(c, tk_curve_vertex_index(c, s.comp[1], s.edge[1])),
+                           tk_curve_vertex(c, tk_curve_vertex_index(c, s.comp[1], s.edge[1] + 1)),
+                           &cl);
+        s.s = cl.s;
+        s.t = cl.t;
+        memcpy(s.p, cl.p, sizeof s.p);
+        memcpy(s.q, cl.q, sizeof s.q);
+        s.length = cl.dist;
+        s.force = 0.0;
+        if (r->struts.count == r->struts.capacity) {
+            size_t cap = r->struts.capacity ? 2 * r->struts.capacity : 64;
+            tk_strut *grown = realloc(r->struts.items, cap * sizeof *grown);
+            if (!grown) {
+                rc = tk_error_set(err, TK_ENOMEM, "out of memory for struts");
+                break;
+            }
+            r->struts.items = grown;
+            r->struts.capacity = cap;
+        }
+        r->struts.items[r->struts.count++] = s;
+        (*added)++;
+    }
+    tk_strut_list_free(&broken);
+    tk_kink *bent = NULL;
+    size_t nbent = 0;
+    if (!rc)
+        rc = tk_kinks_find(trial, 2.0 * r->min_radius * floor, &bent, &nbent, err);
+    for (size_t k = 0; !rc && k < nbent; k++) {
+        bool known = false;
+        for (size_t i = 0; i < r->nkinks && !known; i++)
+            known = r->kinks[i].comp == bent[k].comp && r->kinks[i].vertex == bent[k].vertex;
+        if (known)
+            continue;
+        tk_kink *grown = realloc(r->kinks, (r->nkinks + 1) * sizeof *grown);
+        if (!grown) {
+            rc = tk_error_set(err, TK_ENOMEM, "out of memory for kinks");
+            break;
+        }
+        r->kinks = grown;
+        size_t v = tk_curve_vertex_index(c, bent[k].comp, bent[k].vertex), prev, next;
+        tk_curve_vertex_neighbours(c, v, &prev, &next);
+        r->kinks[r->nkinks++] = (tk_kink){
+            bent[k].comp, bent[k].vertex,
+            tk_vertex_minrad(tk_curve_vertex(c, prev), tk_curve_vertex(c, v),
+                             tk_curve_vertex(c, next)),
+            0.0};
+        (*added)++;
+    }
+    free(bent);
+    if (!rc)
+        rc = grow_constraints(r, r->struts.count + r->nkinks, err);
+    return rc;
+}
+
+/* No vertex may move more than a tenth of the diameter or a quarter of
+ * the shortest edge in one step, so no strand can pass through another
+ * between two checks and no edge folds over: the largest step size for the
+ * current motion (0 when nothing moves). */
+static double largest_step(const tk_run *r)
+{
+    const tk_curve *c = r->curve;
+    double fastest = 0.0;
+    for (size_t v = 0; v < c->nvert; v++)
+        fastest = fmax(fastest, norm(r->motion + 3 * v, 3));
+    if (!(fastest > 0.0))
+        return 0.0;
+    double shortest_edge;
+    tk_curve_edge_range(c, &shortest_edge, NULL);
+    return fmin(0.1 * r->tau, 0.25 * shortest_edge) / fastest;
 }
 
 /* Section 4.5: the largest step, halving from twice the last one, whose
@@ -574,20 +757,13 @@ static int take_step(tk_run *r, tk_step_report *rep, tk_error *err)
 {
     tk_curve *c = r->curve, *t = r->trial;
     size_t n3 = 3 * c->nvert;
-    double fastest = 0.0;
-    for (size_t v = 0; v < c->nvert; v++)
-        fastest = fmax(fastest, norm(r->motion + 3 * v, 3));
-    if (!(fastest > 0.0)) {
+    double largest = largest_step(r);
+    if (!(largest > 0.0)) {
         rep->step_size = 0.0;
         return TK_OK;
     }
-    /* No vertex moves more than a tenth of the diameter or a quarter of the
-     * shortest edge in one step, so no strand can pass through another
-     * between two checks and no edge folds over. */
-    double shortest_edge;
-    tk_curve_edge_range(c, &shortest_edge, NULL);
-    double largest = fmin(0.1 * r->tau, 0.25 * shortest_edge) / fastest;
     double h = r->step_size > 0.0 ? fmin(2.0 * r->step_size, largest) : largest / 8.0;
+    int expansions = 0;
     for (int halving = 0; halving < MAX_HALVINGS; halving++, h *= 0.5) {
         for (size_t i = 0; i < n3; i++)
             t->xyz[i] = c->xyz[i] + h * r->motion[i];
@@ -596,6 +772,27 @@ static int take_step(tk_run *r, tk_step_report *rep, tk_error *err)
         int rc = violation(r, t, &worst, err);
         if (rc)
             return rc;
+        if (worst > r->opt.overstep_tolerance && expansions < MAX_EXPANSIONS &&
+            halving >= HALVINGS_BEFORE_EXPANDING) {
+            /* Constraints the step keeps running into: make them active,
+             * resolve again and retry the same step size.  Not at the first
+             * failure: a shorter step is cheaper than a new resolution, and
+             * usually enough. */
+            size_t added = 0;
+            rc = expand_active(r, t, &added, err);
+            if (rc)
+                return rc;
+            if (added > 0) {
+                expansions++;
+                tk_strut_finder_refit(r->finder, c);
+                rc = resolve(r, rep, err);
+                if (rc)
+                    return rc;
+                largest = largest_step(r);
+                h = 2.0 * fmin(h, largest); /* undo this iteration's halving */
+                continue;
+            }
+        }
         if (worst <= r->opt.overstep_tolerance) {
             memcpy(c->xyz, t->xyz, n3 * sizeof *c->xyz);
             r->step_size = h;

@@ -10,13 +10,16 @@
  * Cholesky of the normal equations, A_F^T A_F x_F = A_F^T b, and exchanges
  * every variable that violates the KKT conditions at once; when the number
  * of violations stops falling the exchange falls back to the single-variable
- * rule (Murty's), which always terminates.
+ * rule (Murty's), which terminates when A^T A is positive definite.  When
+ * it is not (n > m, dependent columns) and the single-variable rule stalls,
+ * Lawson and Hanson's active-set method finishes from the best iterate.
  *
  * Rank-deficient or ill-conditioned A is normal in the flow (symmetric
  * starts, many contacts).  The solver estimates the reciprocal condition
  * number of each factorisation (CHOLMOD's estimate), and when a
  * factorisation fails or is too ill-conditioned it adds a small Tikhonov
- * term (A^T A + delta I), reported in tk_nnls_report.
+ * term, reported in tk_nnls_report.  Columns are scaled to unit norm
+ * inside, so delta is relative: A^T A + delta D with D = diag(A^T A).
  *
  * A tk_nnls owns its cholmod_common and workspace: one per thread.  It keeps
  * the symbolic analysis between calls and reuses it when the passive set's
@@ -35,21 +38,31 @@
 typedef struct tk_nnls tk_nnls;
 
 typedef struct tk_nnls_options {
-    int max_iterations;     /* outer pivoting iterations; default 50 + 2n */
+    int max_iterations;     /* outer pivoting iterations, block pivoting and
+                               its fallback together; default 50 + 2n */
     double kkt_tolerance;   /* relative tolerance on the KKT tests; 1e-10 */
     double rcond_floor;     /* regularise factorisations below this; 1e-14 */
+    bool warm_start;        /* x holds a guess on entry: its positive entries
+                               are the first passive set (in the flow, the
+                               previous step's answer: pivoting then often
+                               ends in one or two iterations) */
 } tk_nnls_options;
 
-#define TK_NNLS_OPTIONS_INIT {0, 1e-10, 1e-14}
+#define TK_NNLS_OPTIONS_INIT {0, 1e-10, 1e-14, false}
 
 typedef struct tk_nnls_report {
     int iterations;         /* pivoting iterations */
     int factorisations;     /* Cholesky factorisations done */
-    bool used_fallback;     /* the single-variable exchange rule was needed */
+    bool used_fallback;     /* the single-variable exchange rule (or the
+                               Lawson-Hanson fallback) was needed */
     bool regularised;       /* a Tikhonov term was added */
-    double regularisation;  /* the largest delta used (0 if none) */
+    double regularisation;  /* the largest delta used, relative to the
+                               diagonal (0 if none) */
     double rcond;           /* smallest reciprocal condition estimate seen
-                               (of A_F^T A_F; 1 when no column is passive) */
+                               (of A_F^T A_F with unit-norm columns: the
+                               pivot ratio of its Cholesky factor, as
+                               cholmod_rcond; 0 for a singular one; 1 when
+                               no column is passive) */
     double residual;        /* || A x - b || at the answer */
     size_t passive;         /* number of x_i > 0 */
 } tk_nnls_report;
@@ -69,8 +82,10 @@ int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *
                   const tk_nnls_options *opts, tk_nnls_report *report, tk_error *err);
 
 /* The minimum-norm solution du (m entries) of the underdetermined system
- * A^T du = r (r has n entries), du = A y with (A^T A + delta I) y = r,
- * delta = 0 unless the factorisation needs it (then *delta_used > 0).
+ * A^T du = r (r has n entries), du = A y with (A^T A + delta D) y = r,
+ * D = diag(A^T A), delta = 0 unless the factorisation needs it (then
+ * *delta_used = delta > 0).  Zero columns of A are left out (their rows
+ * of A^T du = r cannot hold unless r is 0 there).  delta_used may be NULL.
  * Used for error recovery (section 4.6). */
 int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, double *du,
                      double *delta_used, tk_error *err);

@@ -1,0 +1,185 @@
+/* Tightening benchmark: catalogue knots and links at resolution 5, each run
+ * for a fixed wall time, printing vertices, steps per second, the time to
+ * reach given ropelengths, the ropelength after 10 s, 60 s and the full
+ * time, the final residual and the peak memory; then seconds per step
+ * against vertex count on the trefoil.  Prints figures; never fails on
+ * time.
+ *
+ *   bench/tighten [CATALOGUE_DIR] [--seconds S] [--scaling-steps N] [KNOT ...]
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+
+#include "tk/curve.h"
+#include "tk/thickness.h"
+#include "tk/tighten.h"
+#include "tk/vect.h"
+
+static double peak_mib(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_maxrss / 1024.0;
+}
+
+/* Ropelength thresholds whose crossing times are reported, per knot (the
+ * published comparison figures), and the lowest ropelength seen at the
+ * checkpoints. */
+typedef struct progress {
+    const double *thresholds;
+    size_t nthresholds;
+    double crossed[4];
+    double checkpoints[3];  /* seconds */
+    double at_checkpoint[3];
+} progress;
+
+static int on_step(const tk_step_report *s, void *user)
+{
+    progress *p = user;
+    for (size_t k = 0; k < p->nthresholds; k++)
+        if (p->crossed[k] < 0 && s->ropelength <= p->thresholds[k])
+            p->crossed[k] = s->seconds;
+    for (int k = 0; k < 3; k++)
+        if (s->seconds <= p->checkpoints[k])
+            p->at_checkpoint[k] = s->ropelength;
+    return 0;
+}
+
+static tk_curve *load(const char *dir, const char *name)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s.vect", dir, name);
+    tk_curve *c = NULL;
+    tk_error err;
+    if (tk_vect_read_file(path, NULL, &c, &err) != TK_OK) {
+        fprintf(stderr, "bench: %s\n", err.message);
+        return NULL;
+    }
+    return c;
+}
+
+static void run_knot(const char *dir, const char *name, double seconds)
+{
+    static const double t31[] = {33.0, 32.80};
+    static const double t221[] = {25.15};
+    progress p = {NULL, 0, {-1, -1, -1, -1}, {10, 60, seconds}, {NAN, NAN, NAN}};
+    if (strcmp(name, "3.1") == 0) {
+        p.thresholds = t31;
+        p.nthresholds = 2;
+    } else if (strcmp(name, "2.2.1") == 0) {
+        p.thresholds = t221;
+        p.nthresholds = 1;
+    }
+    tk_curve *c = load(dir, name);
+    if (!c)
+        return;
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 5;
+    o.max_seconds = seconds;
+    tk_run *run = NULL;
+    tk_error err;
+    if (tk_run_new(c, &o, &run, &err) != TK_OK) {
+        fprintf(stderr, "bench: %s: %s\n", name, err.message);
+        tk_curve_free(&c);
+        return;
+    }
+    tk_run_set_progress(run, on_step, &p);
+    tk_stop_reason why;
+    int rc = tk_run_until(run, &why, &err);
+    const tk_step_report *last = tk_run_latest(run);
+    char crossed[128] = "";
+    size_t used = 0;
+    for (size_t k = 0; k < p.nthresholds; k++) {
+        int n;
+        if (p.crossed[k] >= 0)
+            n = snprintf(crossed + used, sizeof crossed - used, "%s<=%.2f@%.2fs", k ? " " : "",
+                         p.thresholds[k], p.crossed[k]);
+        else
+            n = snprintf(crossed + used, sizeof crossed - used, "%s<=%.2f@never", k ? " " : "",
+                         p.thresholds[k]);
+        if (n > 0 && (size_t)n < sizeof crossed - used)
+            used += (size_t)n;
+    }
+    printf("%-7s %8zu %8ld %9.1f %10.5f %10.5f %10.5f %10.3g %8.1f  %s%s%s\n", name,
+           last->vertices, last->step, (double)last->step / fmax(last->seconds, 1e-9),
+           p.at_checkpoint[0], p.at_checkpoint[1], last->ropelength, last->residual,
+           peak_mib(), crossed, rc ? "  FAILED: " : "", rc ? err.message : "");
+    fflush(stdout);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+
+/* Seconds per step on the trefoil resampled to growing vertex counts
+ * (the first steps, where contacts are few). */
+static void scaling(const char *dir, long steps)
+{
+    tk_curve *c = load(dir, "3.1");
+    if (!c)
+        return;
+    printf("\nseconds per step, trefoil, first %ld steps:\n%8s %12s %8s\n", steps, "vertices",
+           "ms/step", "struts");
+    for (size_t v = 184; v <= 12000; v *= 2) {
+        tk_curve *big = NULL;
+        tk_error err;
+        if (tk_curve_resample_total(c, v, &big, &err) != TK_OK)
+            break;
+        tk_options o = TK_OPTIONS_INIT;
+        o.autoscale = true;
+        o.max_steps = steps;
+        tk_run *run = NULL;
+        if (tk_run_new(big, &o, &run, &err) == TK_OK) {
+            tk_run_until(run, NULL, &err);
+            const tk_step_report *last = tk_run_latest(run);
+            printf("%8zu %12.3f %8zu\n", v, 1e3 * last->seconds / (double)last->step,
+                   last->struts);
+            fflush(stdout);
+        }
+        tk_run_free(&run);
+        tk_curve_free(&big);
+    }
+    tk_curve_free(&c);
+}
+
+int main(int argc, char **argv)
+{
+    const char *dir = "../shared/catalogue";
+    double seconds = 300.0;
+    long scaling_steps = 20;
+    const char *knots[16];
+    size_t nknots = 0;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            printf("usage: tighten [CATALOGUE_DIR] [--seconds S] [--scaling-steps N] [KNOT ...]\n"
+                   "Tightens catalogue knots at resolution 5 for S seconds each (default 300)\n"
+                   "and prints figures; then seconds per step against vertex count.\n");
+            return 0;
+        } else if (strcmp(argv[i], "--seconds") == 0 && i + 1 < argc) {
+            seconds = strtod(argv[++i], NULL);
+        } else if (strcmp(argv[i], "--scaling-steps") == 0 && i + 1 < argc) {
+            scaling_steps = strtol(argv[++i], NULL, 10);
+        } else if (strchr(argv[i], '/') || strcmp(argv[i], ".") == 0) {
+            dir = argv[i];
+        } else if (nknots < 16) {
+            knots[nknots++] = argv[i];
+        }
+    }
+    if (nknots == 0) {
+        const char *all[] = {"3.1", "4.1", "5.1", "2.2.1", "6.3.2", "10.1"};
+        for (size_t k = 0; k < 6; k++)
+            knots[nknots++] = all[k];
+    }
+    printf("tightening at resolution 5, %.0f s each; ropelength after 10 s, 60 s and at "
+           "the end\n\n", seconds);
+    printf("%-7s %8s %8s %9s %10s %10s %10s %10s %8s  %s\n", "knot", "vertices", "steps",
+           "steps/s", "rope@10s", "rope@60s", "rope@end", "residual", "peak_MiB",
+           "thresholds");
+    for (size_t k = 0; k < nknots; k++)
+        run_knot(dir, knots[k], seconds);
+    if (scaling_steps > 0)
+        scaling(dir, scaling_steps);
+    return 0;
+}
