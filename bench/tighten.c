@@ -104,10 +104,18 @@ static void run_knot(const char *dir, const char *name, double seconds)
         if (n > 0 && (size_t)n < sizeof crossed - used)
             used += (size_t)n;
     }
-    printf("%-7s %8zu %8ld %9.1f %10.5f %10.5f %10.5f %10.3g %8.1f  %s%s%s\n", name,
-           last->vertices, last->step, (double)last->step / fmax(last->seconds, 1e-9),
-           p.at_checkpoint[0], p.at_checkpoint[1], last->ropelength, last->residual,
-           peak_mib(), crossed, rc ? "  FAILED: " : "", rc ? err.message : "");
+    /* a run that stopped before a checkpoint has no figure there */
+    char at[2][16];
+    for (int k = 0; k < 2; k++) {
+        if (last->seconds >= p.checkpoints[k])
+            snprintf(at[k], sizeof at[k], "%.5f", p.at_checkpoint[k]);
+        else
+            snprintf(at[k], sizeof at[k], "-");
+    }
+    printf("%-7s %8zu %8ld %9.1f %10s %10s %10.5f %10.3g %8.1f  %s (%s)%s%s\n", name,
+           last->vertices, last->step, (double)last->step / fmax(last->seconds, 1e-9), at[0],
+           at[1], last->ropelength, last->residual, peak_mib(), crossed,
+           tk_stop_reason_name(why), rc ? "  FAILED: " : "", rc ? err.message : "");
     fflush(stdout);
     tk_run_free(&run);
     tk_curve_free(&c);

@@ -763,6 +763,7 @@ static int take_step(tk_run *r, tk_step_report *rep, tk_error *err)
         return TK_OK;
     }
     double h = r->step_size > 0.0 ? fmin(2.0 * r->step_size, largest) : largest / 8.0;
+    double length_before = tk_curve_length(c);
     int expansions = 0;
     for (int halving = 0; halving < MAX_HALVINGS; halving++, h *= 0.5) {
         for (size_t i = 0; i < n3; i++)
@@ -793,7 +794,9 @@ static int take_step(tk_run *r, tk_step_report *rep, tk_error *err)
                 continue;
             }
         }
-        if (worst <= r->opt.overstep_tolerance) {
+        /* The resolved motion shortens the curve to first order; a step
+         * that makes it longer went too far along a curved constraint. */
+        if (worst <= r->opt.overstep_tolerance && tk_curve_length(t) <= length_before) {
             memcpy(c->xyz, t->xyz, n3 * sizeof *c->xyz);
             r->step_size = h;
             rep->step_size = h;
