@@ -576,10 +576,11 @@ static int remember_forces(tk_run *r, tk_error *err)
         known->items = grown;
         known->capacity = r->struts.count;
     }
-    if (r->struts.count)
-        memcpy(known->items, r->struts.items, r->struts.count * sizeof *known->items);
     known->count = r->struts.count;
-    qsort(known->items, known->count, sizeof *known->items, compare_strut_edges);
+    if (known->count) {
+        memcpy(known->items, r->struts.items, known->count * sizeof *known->items);
+        qsort(known->items, known->count, sizeof *known->items, compare_strut_edges);
+    }
     free(r->known_kinks);
     r->known_kinks = NULL;
     r->nknown_kinks = 0;
