@@ -972,9 +972,5 @@ int main(void)
     tcase_set_timeout(bad, 10);
     tcase_add_test(bad, resample_rejects_invalid_input);
     suite_add_tcase(s, bad);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return tkt_run_suite(s);
 }

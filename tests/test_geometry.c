@@ -26,23 +26,6 @@ static double seg_dist(const double *x)
     return c.dist;
 }
 
-/* Distance from point x to segment (b0, b1), by projection. */
-static double point_segment(const double *x, const double *b0, const double *b1)
-{
-    double d[3], r[3], dd = 0, rd = 0;
-    for (int k = 0; k < 3; k++) {
-        d[k] = b1[k] - b0[k];
-        r[k] = x[k] - b0[k];
-        dd += d[k] * d[k];
-        rd += r[k] * d[k];
-    }
-    double t = dd > 0 ? fmin(1, fmax(0, rd / dd)) : 0;
-    double s2 = 0;
-    for (int k = 0; k < 3; k++)
-        s2 += (r[k] - t * d[k]) * (r[k] - t * d[k]);
-    return sqrt(s2);
-}
-
 /* An independent estimate of the segment distance: the distance from p(s)
  * to the second segment is convex in s, so a scan followed by ternary
  * search finds its minimum. */
@@ -55,7 +38,7 @@ static double sampled_dist(const double *x)
         double s = (double)i / n;
         for (int k = 0; k < 3; k++)
             p[k] = x[k] + s * (x[3 + k] - x[k]);
-        double d = point_segment(p, x + 6, x + 9);
+        double d = tkt_point_segment(p, x + 6, x + 9);
         if (d < best) {
             best = d;
             bs = s;
@@ -68,14 +51,14 @@ static double sampled_dist(const double *x)
             p[k] = x[k] + m1 * (x[3 + k] - x[k]);
             p2[k] = x[k] + m2 * (x[3 + k] - x[k]);
         }
-        if (point_segment(p, x + 6, x + 9) < point_segment(p2, x + 6, x + 9))
+        if (tkt_point_segment(p, x + 6, x + 9) < tkt_point_segment(p2, x + 6, x + 9))
             hi = m2;
         else
             lo = m1;
     }
     for (int k = 0; k < 3; k++)
         p[k] = x[k] + lo * (x[3 + k] - x[k]);
-    return fmin(best, point_segment(p, x + 6, x + 9));
+    return fmin(best, tkt_point_segment(p, x + 6, x + 9));
 }
 
 /* Random segment pairs of several kinds, including nearly degenerate ones. */
@@ -357,9 +340,5 @@ int main(void)
     tcase_add_test(tc, length_gradient_matches_finite_differences);
     tcase_add_test(tc, vertex_neighbours);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return tkt_run_suite(s);
 }

@@ -967,9 +967,5 @@ int main(void)
     tcase_add_test(tc, min_norm_solutions);
     tcase_add_test(tc, two_threads_match_series);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return tkt_run_suite(s);
 }

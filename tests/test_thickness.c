@@ -35,29 +35,12 @@ START_TEST(regular_polygon_exact)
 }
 END_TEST
 
-/* Distance from point x to segment (b0, b1), by projection. */
-static double point_segment(const double *x, const double *b0, const double *b1)
-{
-    double d[3], r[3], dd = 0, rd = 0;
-    for (int k = 0; k < 3; k++) {
-        d[k] = b1[k] - b0[k];
-        r[k] = x[k] - b0[k];
-        dd += d[k] * d[k];
-        rd += r[k] * d[k];
-    }
-    double t = dd > 0 ? fmin(1, fmax(0, rd / dd)) : 0;
-    double s2 = 0;
-    for (int k = 0; k < 3; k++)
-        s2 += (r[k] - t * d[k]) * (r[k] - t * d[k]);
-    return sqrt(s2);
-}
-
 static double point_to_component(const tk_curve *c, size_t comp, const double *x)
 {
     double best = INFINITY;
     size_t ne = tk_curve_comp_edges(c, comp);
     for (size_t k = 0; k < ne; k++)
-        best = fmin(best, point_segment(x, tk_curve_vertex(c, tk_curve_vertex_index(c, comp, k)),
+        best = fmin(best, tkt_point_segment(x, tk_curve_vertex(c, tk_curve_vertex_index(c, comp, k)),
                                         tk_curve_vertex(c, tk_curve_vertex_index(c, comp, k + 1))));
     return best;
 }
@@ -294,9 +277,5 @@ int main(void)
     tcase_add_test(tc, doubly_critical_matters);
     tcase_add_test(tc, contacts_of_tight_trefoil);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return tkt_run_suite(s);
 }

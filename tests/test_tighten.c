@@ -329,9 +329,5 @@ int main(void)
     tcase_add_test(tc, hopf_link_tightens_towards_8_pi);
     tcase_add_test(tc, catalogue_trefoil_at_resolution_5);
     suite_add_tcase(s, tc);
-    SRunner *sr = srunner_create(s);
-    srunner_run_all(sr, CK_NORMAL);
-    int failed = srunner_ntests_failed(sr);
-    srunner_free(sr);
-    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+    return tkt_run_suite(s);
 }

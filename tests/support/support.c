@@ -121,3 +121,28 @@ double tkt_reldiff(double a, double b)
     double m = fmax(fmax(fabs(a), fabs(b)), 1e-300);
     return fabs(a - b) / m;
 }
+
+double tkt_point_segment(const double *x, const double *b0, const double *b1)
+{
+    double d[3], r[3], dd = 0, rd = 0;
+    for (int k = 0; k < 3; k++) {
+        d[k] = b1[k] - b0[k];
+        r[k] = x[k] - b0[k];
+        dd += d[k] * d[k];
+        rd += r[k] * d[k];
+    }
+    double t = dd > 0 ? fmin(1, fmax(0, rd / dd)) : 0;
+    double s2 = 0;
+    for (int k = 0; k < 3; k++)
+        s2 += (r[k] - t * d[k]) * (r[k] - t * d[k]);
+    return sqrt(s2);
+}
+
+int tkt_run_suite(Suite *s)
+{
+    SRunner *sr = srunner_create(s);
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}

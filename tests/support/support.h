@@ -33,4 +33,13 @@ tk_curve *tkt_regular_polygon(size_t n, double radius);
 /* Relative difference |a - b| / max(|a|, |b|, tiny). */
 double tkt_reldiff(double a, double b);
 
+/* Distance from point x to the segment (b0, b1), by projection: an
+ * independent reference for the engine's edge distances. */
+double tkt_point_segment(const double *x, const double *b0, const double *b1);
+
+/* Runs a suite with Check's normal output (its summary line is what the
+ * test runner counts); returns the process exit status. */
+struct Suite;
+int tkt_run_suite(struct Suite *s);
+
 #endif
