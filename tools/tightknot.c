@@ -180,6 +180,9 @@ static const char tighten_help[] =
     "                    input's vertices)\n"
     "  --autoscale       first scale the curve so its thickness is just above\n"
     "                    the diameter (needed when the input is thinner)\n"
+    "  --overstep EPS    largest constraint violation a step may make, as a\n"
+    "                    fraction of the diameter (default 1e-5; violations\n"
+    "                    are corrected down to EPS / 10)\n"
     "Stop criteria (the first met stops the run; default --steps 1000):\n"
     "  --steps N         after N steps\n"
     "  --time SECONDS    after this much wall time\n"
@@ -224,12 +227,13 @@ enum {
     OPT_STRUTS_OUT = 1u << 11,
     OPT_LOG = 1u << 12,
     OPT_SNAPSHOTS = 1u << 13,
-    OPT_EVERY = 1u << 14
+    OPT_EVERY = 1u << 14,
+    OPT_OVERSTEP = 1u << 15
 };
 #define TIGHTEN_OPTIONS                                                                   \
     (OPT_JSON | OPT_RADIUS | OPT_LAMBDA | OPT_RESOLUTION | OPT_AUTOSCALE | OPT_STEPS |     \
      OPT_TIME | OPT_RESIDUAL | OPT_OUTPUT | OPT_STRUTS_OUT | OPT_LOG | OPT_SNAPSHOTS |     \
-     OPT_EVERY)
+     OPT_EVERY | OPT_OVERSTEP)
 
 typedef struct option_spec {
     const char *name;
@@ -253,6 +257,7 @@ static const option_spec option_specs[] = {
     {"log", OPT_LOG, true},
     {"snapshots", OPT_SNAPSHOTS, true},
     {"every", OPT_EVERY, true},
+    {"overstep", OPT_OVERSTEP, true},
 };
 
 typedef struct cli_args {
@@ -348,12 +353,14 @@ static int apply_option(const char *cmd, unsigned flag, const char *value, cli_a
     case OPT_LAMBDA:
     case OPT_RESOLUTION:
     case OPT_TIME:
-    case OPT_RESIDUAL: {
+    case OPT_RESIDUAL:
+    case OPT_OVERSTEP: {
         double x = 0.0;
         const char *name = flag == OPT_RADIUS       ? "--radius"
                            : flag == OPT_LAMBDA     ? "--lambda"
                            : flag == OPT_RESOLUTION ? "--resolution"
                            : flag == OPT_TIME       ? "--time"
+                           : flag == OPT_OVERSTEP   ? "--overstep"
                                                     : "--residual";
         if (parse_real(cmd, name, value, &x))
             return EXIT_USAGE;
@@ -369,6 +376,12 @@ static int apply_option(const char *cmd, unsigned flag, const char *value, cli_a
             a->run.resolution = x;
         else if (flag == OPT_TIME)
             a->run.max_seconds = x;
+        else if (flag == OPT_OVERSTEP) {
+            if (!(x > 0.0 && x < 0.1))
+                return usage_error(cmd, "--overstep: '%s' must be in (0, 0.1)", value);
+            a->run.overstep_tolerance = x;
+            a->run.correction_tolerance = 0.1 * x;
+        }
         else
             a->run.min_residual = x;
         return EXIT_OK;

@@ -57,7 +57,7 @@ typedef struct tk_options {
 
 #define TK_OPTIONS_INIT                                                                  \
     {                                                                                    \
-        0.5, 1.0, 0.0, false, 1.002, 0, 0.0, 0.0, 0.0, 20, 3e-4, 1e-4, 1e-5, 0.5, 0      \
+        0.5, 1.0, 0.0, false, 1.002, 0, 0.0, 0.0, 0.0, 20, 3e-4, 1e-5, 1e-6, 0.5, 0      \
     }
 
 /* Why a run stopped. */
