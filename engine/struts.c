@@ -519,8 +519,9 @@ static int check_counts(const tk_strut_finder *f, const tk_curve *c, tk_error *e
     return TK_OK;
 }
 
-int tk_strut_finder_find(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule,
-                         double tau, double bound, tk_strut_list *out, tk_error *err)
+/* Checks a query's arguments and fills the arc rule's sums. */
+static int begin_query(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule, double tau,
+                       tk_error *err)
 {
     int rc = check_counts(f, c, err);
     if (rc)
@@ -528,6 +529,15 @@ int tk_strut_finder_find(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule
     if (rule == TK_ARC_ADMISSIBLE && !(tau > 0.0))
         return tk_error_set(err, TK_EINVAL, "the diameter must be positive (got %g)", tau);
     fill_prefix(f, c, rule, tau);
+    return TK_OK;
+}
+
+int tk_strut_finder_find(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule,
+                         double tau, double bound, tk_strut_list *out, tk_error *err)
+{
+    int rc = begin_query(f, c, rule, tau, err);
+    if (rc)
+        return rc;
     size_t start = out->count;
     query qy = {f, c, rule, bound, false, false, {{0}}, out, TK_OK};
     if (f->nedges > 1 && bound >= 0.0)
@@ -542,10 +552,9 @@ int tk_strut_finder_find(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule
 int tk_strut_finder_shortest(tk_strut_finder *f, const tk_curve *c, double *shortest,
                              tk_strut *where, tk_error *err)
 {
-    int rc = check_counts(f, c, err);
+    int rc = begin_query(f, c, TK_ARC_FENCHEL, 0.0, err);
     if (rc)
         return rc;
-    fill_prefix(f, c, TK_ARC_FENCHEL, 0.0);
     query qy = {f, c, TK_ARC_FENCHEL, INFINITY, true, false, {{0}}, NULL, TK_OK};
     *shortest = INFINITY;
     if (f->nedges < 2)
@@ -585,12 +594,9 @@ int tk_strut_finder_shortest(tk_strut_finder *f, const tk_curve *c, double *shor
 int tk_strut_finder_closest_pair(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule,
                                  double tau, double below, double *dist, tk_error *err)
 {
-    int rc = check_counts(f, c, err);
+    int rc = begin_query(f, c, rule, tau, err);
     if (rc)
         return rc;
-    if (rule == TK_ARC_ADMISSIBLE && !(tau > 0.0))
-        return tk_error_set(err, TK_EINVAL, "the diameter must be positive (got %g)", tau);
-    fill_prefix(f, c, rule, tau);
     query qy = {f, c, rule, below, true, true, {{0}}, NULL, TK_OK};
     if (f->nedges > 1)
         visit(&qy, 0, 0);
