@@ -496,7 +496,9 @@ static void visit(query *qy, size_t xi, size_t yi)
         visit(qy, pairs[k][0], pairs[k][1]);
 }
 
-static int compare_struts(const void *pa, const void *pb)
+/* An edge pair yields at most one strut, so this order is total on a
+ * strut list. */
+int tk_strut_compare_edges(const void *pa, const void *pb)
 {
     const tk_strut *a = pa, *b = pb;
     for (int k = 0; k < 2; k++) {
@@ -505,10 +507,6 @@ static int compare_struts(const void *pa, const void *pb)
         if (a->edge[k] != b->edge[k])
             return a->edge[k] < b->edge[k] ? -1 : 1;
     }
-    if (a->s != b->s)
-        return a->s < b->s ? -1 : 1;
-    if (a->t != b->t)
-        return a->t < b->t ? -1 : 1;
     return 0;
 }
 
@@ -545,7 +543,8 @@ int tk_strut_finder_find(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule
     if (qy.status != TK_OK)
         return tk_error_set(err, qy.status, "out of memory listing struts");
     if (out->count > start)
-        qsort(out->items + start, out->count - start, sizeof *out->items, compare_struts);
+        qsort(out->items + start, out->count - start, sizeof *out->items,
+              tk_strut_compare_edges);
     return TK_OK;
 }
 
@@ -623,7 +622,8 @@ int tk_struts_find_brute(const tk_curve *c, tk_arc_rule rule, double tau, double
     if (qy.status != TK_OK)
         return tk_error_set(err, qy.status, "out of memory listing struts");
     if (out->count > start)
-        qsort(out->items + start, out->count - start, sizeof *out->items, compare_struts);
+        qsort(out->items + start, out->count - start, sizeof *out->items,
+              tk_strut_compare_edges);
     return TK_OK;
 }
 

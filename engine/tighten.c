@@ -523,18 +523,6 @@ void tk_run_cancel(tk_run *r)
     atomic_store(&r->cancel, 1);
 }
 
-static int compare_strut_edges(const void *pa, const void *pb)
-{
-    const tk_strut *a = pa, *b = pb;
-    for (int k = 0; k < 2; k++) {
-        if (a->comp[k] != b->comp[k])
-            return a->comp[k] < b->comp[k] ? -1 : 1;
-        if (a->edge[k] != b->edge[k])
-            return a->edge[k] < b->edge[k] ? -1 : 1;
-    }
-    return 0;
-}
-
 static int compare_kink_vertices(const void *pa, const void *pb)
 {
     const tk_kink *a = pa, *b = pb;
@@ -552,7 +540,7 @@ static void guess_forces(const tk_run *r)
         const tk_strut *hit =
             r->known_struts.count
                 ? bsearch(&r->struts.items[j], r->known_struts.items, r->known_struts.count,
-                          sizeof *hit, compare_strut_edges)
+                          sizeof *hit, tk_strut_compare_edges)
                 : NULL;
         r->x[j] = hit ? hit->force : 0.0;
     }
@@ -579,7 +567,7 @@ static int remember_forces(tk_run *r, tk_error *err)
     known->count = r->struts.count;
     if (known->count) {
         memcpy(known->items, r->struts.items, known->count * sizeof *known->items);
-        qsort(known->items, known->count, sizeof *known->items, compare_strut_edges);
+        qsort(known->items, known->count, sizeof *known->items, tk_strut_compare_edges);
     }
     free(r->known_kinks);
     r->known_kinks = NULL;

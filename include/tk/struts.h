@@ -57,6 +57,10 @@ typedef struct tk_strut_list {
     size_t capacity;
 } tk_strut_list;
 
+/* qsort/bsearch order of struts by their edge pairs (component, edge of
+ * the first edge, then of the second); the parameters are not compared. */
+int tk_strut_compare_edges(const void *a, const void *b);
+
 void tk_strut_list_clear(tk_strut_list *list);
 void tk_strut_list_free(tk_strut_list *list);
 
