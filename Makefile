@@ -41,6 +41,12 @@ ENGINE_SRC := $(wildcard engine/*.c)
 ENGINE_OBJ := $(ENGINE_SRC:%.c=$(BUILD)/%.o)
 LIB := $(BUILD)/libtightknot.a
 
+SERVER_SRC := $(filter-out server/tightknotd.c,$(wildcard server/*.c))
+SERVER_OBJ := $(SERVER_SRC:%.c=$(BUILD)/%.o)
+SERVER_LIB := $(BUILD)/libtkserver.a
+SERVER_LIBS := -lmicrohttpd -ljansson -lsqlite3
+DAEMON := $(BUILD)/tightknotd
+
 CLI_SRC := $(wildcard tools/tightknot*.c)
 CLI_OBJ := $(CLI_SRC:%.c=$(BUILD)/%.o)
 CLI := $(BUILD)/tightknot
@@ -58,7 +64,7 @@ BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 .PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten \
 	lint headers clean
 
-all: $(LIB) $(CLI)
+all: $(LIB) $(CLI) $(DAEMON)
 
 deps:
 	$(Q)./tools/install-deps.sh
@@ -72,13 +78,22 @@ $(LIB): $(ENGINE_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
 
-$(CLI): $(CLI_OBJ) $(LIB)
-	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(LIB) -ljansson $(LDLIBS)
+$(SERVER_LIB): $(SERVER_OBJ)
+	@$(if $(Q),echo "  AR      $@")
+	$(Q)rm -f $@ && ar rcs $@ $^
 
-$(BUILD)/tests/%: $(BUILD)/tests/%.o $(TEST_SUPPORT_OBJ) $(LIB)
+$(CLI): $(CLI_OBJ) $(SERVER_LIB) $(LIB)
 	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(LIB) $(CHECK_LIBS) $(LDLIBS)
+	$(Q)$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(SERVER_LIB) $(LIB) $(SERVER_LIBS) $(LDLIBS)
+
+$(DAEMON): $(BUILD)/server/tightknotd.o $(SERVER_LIB) $(LIB)
+	@$(if $(Q),echo "  LD      $@")
+	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(SERVER_LIB) $(LIB) $(SERVER_LIBS) $(LDLIBS)
+
+$(BUILD)/tests/%: $(BUILD)/tests/%.o $(TEST_SUPPORT_OBJ) $(SERVER_LIB) $(LIB)
+	@$(if $(Q),echo "  LD      $@")
+	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(SERVER_LIB) $(LIB) $(CHECK_LIBS) \
+		$(SERVER_LIBS) $(LDLIBS)
 
 $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIB)
 	@$(if $(Q),echo "  LD      $@")
@@ -112,7 +127,7 @@ bench-tighten: deps all $(BENCH_BIN)
 # Banned unsafe calls (curl's list).
 lint:
 	$(Q)! grep -nE '\b(sprintf|strcpy|strcat|atoi|atof|gets)\s*\(' \
-		engine/*.c tools/*.c tests/*.c bench/*.c 2>/dev/null || \
+		engine/*.c server/*.c tools/*.c tests/*.c bench/*.c 2>/dev/null || \
 		(echo "lint: banned call found" && false)
 
 # Each public header compiles on its own.
@@ -124,5 +139,5 @@ headers:
 clean:
 	rm -rf build
 
--include $(ENGINE_OBJ:.o=.d) $(CLI_OBJ:.o=.d) $(TEST_BIN:%=%.d) $(TEST_SUPPORT_OBJ:.o=.d) \
+-include $(ENGINE_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(BUILD)/server/tightknotd.d $(CLI_OBJ:.o=.d) $(TEST_BIN:%=%.d) $(TEST_SUPPORT_OBJ:.o=.d) \
 	$(BENCH_BIN:%=%.d)

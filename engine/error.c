@@ -34,6 +34,8 @@ const char *tk_status_name(int code)
     case TK_ENUMERIC: return "numerical failure";
     case TK_ECANCELLED: return "cancelled";
     case TK_ELIMIT: return "limit exceeded";
+    case TK_ENOTFOUND: return "not found";
+    case TK_EBUSY: return "busy";
     default: return "unknown error";
     }
 }

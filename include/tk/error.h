@@ -17,7 +17,9 @@ enum tk_status {
     TK_EIO = 4,      /* reading or writing a file failed */
     TK_ENUMERIC = 5, /* numerical trouble the engine could not recover from */
     TK_ECANCELLED = 6,
-    TK_ELIMIT = 7    /* input exceeds a configured limit */
+    TK_ELIMIT = 7,   /* input exceeds a configured limit */
+    TK_ENOTFOUND = 8,/* no such item (a job id, a catalogue name) */
+    TK_EBUSY = 9     /* a queue or pool is full; try again later */
 };
 
 #define TK_ERROR_MESSAGE_SIZE 320

@@ -1,0 +1,70 @@
+/* tightknot: the job queue and the worker pool of the service.
+ *
+ * Submitting stores a job and puts its id on a FIFO queue; a fixed pool of
+ * worker threads takes ids off the queue and runs the engine.  While a job
+ * runs, its figures live in the worker's slot (read by tk_jobs_get on every
+ * poll) and are written to the store every few seconds and at the end,
+ * with the curve, so that a restart takes the job up where it was.
+ *
+ * Request handlers only call these functions; none of them runs the
+ * engine's flow.
+ */
+#ifndef TK_JOBS_H
+#define TK_JOBS_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "tk/curve.h"
+#include "tk/error.h"
+#include "tk/store.h"
+
+typedef struct tk_jobs_config {
+    size_t workers;        /* threads running the engine (>= 1) */
+    size_t queue_limit;    /* queued jobs beyond this are refused (TK_EBUSY) */
+    size_t max_vertices;   /* a run's vertex count limit, after re-resolution */
+    double flush_seconds;  /* how often a running job is written to the store */
+    size_t history_limit;  /* history entries kept per job (decimated beyond) */
+} tk_jobs_config;
+
+#define TK_JOBS_CONFIG_INIT {2, 1000, 1000000, 2.0, 2000}
+
+typedef struct tk_jobs tk_jobs;
+
+/* Starts the workers; jobs the store holds as queued or running (left by
+ * a restart or a crash) are queued again first, oldest first. */
+int tk_jobs_start(tk_store *store, const tk_jobs_config *cfg, tk_jobs **out, tk_error *err);
+
+/* Stops taking jobs, stops the running ones within a step and stores them
+ * as queued (with their curve) so that the next start resumes them, then
+ * joins the workers. */
+void tk_jobs_stop(tk_jobs **p);
+
+/* Validates and queues a job: `curve` is the parsed `vect` text.  The
+ * options are checked by setting up a run (re-resolution, autoscale,
+ * thickness) without taking a step.  Fails with TK_EINVAL (bad options or
+ * a start the run refuses), TK_ELIMIT (too many vertices) or TK_EBUSY
+ * (queue full).  On success *job is the stored job. */
+int tk_jobs_submit(tk_jobs *j, const char *name, const tk_job_options *opts,
+                   const tk_curve *curve, const char *vect, tk_job *job, tk_error *err);
+
+/* The job as it is now (live figures while it runs); TK_ENOTFOUND. */
+int tk_jobs_get(tk_jobs *j, int64_t id, tk_job *out, tk_error *err);
+
+/* Cancels a queued job at once, or asks a running one to stop (it does
+ * within a step).  TK_EINVAL when the job has already finished. */
+int tk_jobs_cancel(tk_jobs *j, int64_t id, tk_job *out, tk_error *err);
+
+typedef struct tk_jobs_stats {
+    size_t queued;          /* waiting in the queue */
+    size_t running;         /* being run by workers */
+    size_t workers;
+    size_t queue_limit;
+    unsigned long long steps_total; /* steps taken since start */
+    double steps_per_second;        /* over the running jobs */
+} tk_jobs_stats;
+
+void tk_jobs_stats_get(tk_jobs *j, tk_jobs_stats *out);
+
+#endif

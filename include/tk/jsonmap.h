@@ -1,0 +1,43 @@
+/* tightknot: JSON forms of the engine's results, shared by the command
+ * line and the service so that both write the same documents.
+ *
+ * Numbers that are not finite become null (JSON has no inf or nan).
+ */
+#ifndef TK_JSONMAP_H
+#define TK_JSONMAP_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include <jansson.h>
+
+#include "tk/curve.h"
+#include "tk/struts.h"
+#include "tk/tighten.h"
+
+json_t *tk_json_number(double x);
+json_t *tk_json_point(const double p[3]);
+
+/* A string from arbitrary bytes: bytes that are not ASCII show as '?' when
+ * the text is not valid UTF-8. */
+json_t *tk_json_text(const char *s);
+
+/* One step's figures, every field of tk_step_report. */
+json_t *tk_json_step(const tk_step_report *s);
+
+/* The contacts of curve c:
+ *   {"components": [{"vertices", "closed", "length", "start"}],
+ *    "struts": [{"edges": [[comp, edge], [comp, edge]], "s", "t", "p", "q",
+ *                "length", "arclength": [a, b], "force"}],
+ *    "kinks": [{"comp", "vertex", "minrad", "arclength", "force"}]}
+ * "arclength" is the position along the components laid end to end in
+ * order ("start" is where each component begins), the coordinates of the
+ * contact map.  Forces are included only when with_force. */
+json_t *tk_json_contacts(const tk_curve *c, const tk_strut *struts, size_t nstruts,
+                         const tk_kink *kinks, size_t nkinks, bool with_force);
+
+/* Serialises with 17 significant digits (numbers read back as the same
+ * doubles); compact or indented.  NULL when out of memory. */
+char *tk_json_dump(const json_t *value, bool indent);
+
+#endif

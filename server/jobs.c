@@ -1,0 +1,640 @@
+/* tightknot: the job queue and the worker pool (see include/tk/jobs.h). */
+#define _GNU_SOURCE
+#include "tk/jobs.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "tk/jsonmap.h"
+#include "tk/vect.h"
+
+/* What a worker is doing, visible to the request handlers. */
+typedef struct worker_slot {
+    tk_jobs *owner;
+    pthread_t thread;
+    bool busy;           /* holds a job */
+    bool cancel;         /* the client asked to cancel it */
+    tk_run *run;         /* the engine run, once set up */
+    tk_job job;          /* live record, updated every step */
+} worker_slot;
+
+struct tk_jobs {
+    tk_store *store;
+    tk_jobs_config cfg;
+    pthread_mutex_t lock; /* guards the queue, the slots and stopping */
+    pthread_cond_t wake;
+    int64_t *queue;       /* ring of job ids */
+    size_t queue_cap, queue_head, queue_len;
+    bool stopping;
+    worker_slot *slots;
+    size_t nslots;
+    atomic_ullong steps_total;
+};
+
+static double now_unix(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double now_monotonic(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- queue (lock held) ---- */
+
+static bool queue_push(tk_jobs *j, int64_t id)
+{
+    if (j->queue_len == j->queue_cap) {
+        size_t cap = j->queue_cap ? 2 * j->queue_cap : 64;
+        int64_t *grown = malloc(cap * sizeof *grown);
+        if (!grown)
+            return false;
+        for (size_t i = 0; i < j->queue_len; i++)
+            grown[i] = j->queue[(j->queue_head + i) % j->queue_cap];
+        free(j->queue);
+        j->queue = grown;
+        j->queue_cap = cap;
+        j->queue_head = 0;
+    }
+    j->queue[(j->queue_head + j->queue_len) % j->queue_cap] = id;
+    j->queue_len++;
+    return true;
+}
+
+static int64_t queue_pop(tk_jobs *j)
+{
+    int64_t id = j->queue[j->queue_head];
+    j->queue_head = (j->queue_head + 1) % j->queue_cap;
+    j->queue_len--;
+    return id;
+}
+
+static bool queue_remove(tk_jobs *j, int64_t id)
+{
+    for (size_t i = 0; i < j->queue_len; i++) {
+        size_t at = (j->queue_head + i) % j->queue_cap;
+        if (j->queue[at] != id)
+            continue;
+        for (size_t k = i; k + 1 < j->queue_len; k++)
+            j->queue[(j->queue_head + k) % j->queue_cap] =
+                j->queue[(j->queue_head + k + 1) % j->queue_cap];
+        j->queue_len--;
+        return true;
+    }
+    return false;
+}
+
+static worker_slot *slot_of(tk_jobs *j, int64_t id)
+{
+    for (size_t i = 0; i < j->nslots; i++)
+        if (j->slots[i].busy && j->slots[i].job.id == id)
+            return &j->slots[i];
+    return NULL;
+}
+
+/* ---- history, decimated to a bounded size ---- */
+
+typedef struct history {
+    tk_step_report *items;
+    size_t count, cap;
+    long stride;  /* steps between kept entries */
+} history;
+
+static void history_add(history *h, const tk_step_report *r)
+{
+    if (r->step % h->stride != 0)
+        return;
+    if (h->count == h->cap) {
+        /* keep every other entry: the history stays evenly spaced */
+        size_t kept = 0;
+        for (size_t i = 0; i < h->count; i += 2)
+            h->items[kept++] = h->items[i];
+        h->count = kept;
+        h->stride *= 2;
+        if (r->step % h->stride != 0)
+            return;
+    }
+    h->items[h->count++] = *r;
+}
+
+/* The history as JSON text, with `latest` appended when it is newer than
+ * the last kept entry. */
+static char *history_json(const history *h, const tk_step_report *latest)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; a && i < h->count; i++)
+        json_array_append_new(a, tk_json_step(&h->items[i]));
+    if (a && latest && (h->count == 0 || h->items[h->count - 1].step < latest->step))
+        json_array_append_new(a, tk_json_step(latest));
+    char *text = tk_json_dump(a, false);
+    json_decref(a);
+    return text;
+}
+
+static double number_field(const json_t *o, const char *key)
+{
+    const json_t *v = json_object_get(o, key);
+    return json_is_number(v) ? json_number_value(v) : NAN;
+}
+
+/* Reads a stored history back (after a restart). */
+static void history_load(history *h, const char *text)
+{
+    json_t *a = text ? json_loads(text, 0, NULL) : NULL;
+    size_t n = json_is_array(a) ? json_array_size(a) : 0;
+    for (size_t i = 0; i < n && h->count < h->cap; i++) {
+        const json_t *o = json_array_get(a, i);
+        tk_step_report r = {0};
+        r.step = (long)number_field(o, "step");
+        r.seconds = number_field(o, "seconds");
+        r.ropelength = number_field(o, "ropelength");
+        r.length = number_field(o, "length");
+        r.thickness = number_field(o, "thickness");
+        r.minrad = number_field(o, "minrad");
+        r.residual = number_field(o, "residual");
+        r.struts = (size_t)number_field(o, "struts");
+        r.kinks = (size_t)number_field(o, "kinks");
+        r.step_size = number_field(o, "step_size");
+        r.rcond = number_field(o, "rcond");
+        r.violation = number_field(o, "violation");
+        r.corrections = (int)number_field(o, "corrections");
+        r.vertices = (size_t)number_field(o, "vertices");
+        h->items[h->count++] = r;
+    }
+    if (h->count >= 2)
+        h->stride = h->items[h->count - 1].step - h->items[h->count - 2].step;
+    if (h->stride < 1)
+        h->stride = 1;
+    json_decref(a);
+}
+
+/* ---- running one job ---- */
+
+typedef struct job_run {
+    worker_slot *slot;
+    tk_run *run;
+    long step_offset;       /* steps taken before a restart */
+    double seconds_offset;
+    history hist;
+    double last_flush;      /* monotonic seconds */
+    size_t frames_flushed;  /* run snapshots already stored */
+    size_t frames_before;   /* frames stored before this run */
+    tk_error flush_error;
+} job_run;
+
+static double job_fraction(const tk_job *job)
+{
+    double f = -1.0;
+    if (job->options.steps > 0)
+        f = (double)job->latest.step / (double)job->options.steps;
+    if (job->options.time > 0.0)
+        f = fmax(f, job->latest.seconds / job->options.time);
+    return f < 0.0 ? -1.0 : fmin(f, 1.0);
+}
+
+/* Writes the job's figures, curve, history and new frames to the store;
+ * contacts too when final. */
+static int flush_job(job_run *jr, const tk_job *job, bool final, tk_error *err)
+{
+    char *curve = NULL, *contacts = NULL, *hist = NULL;
+    int rc = tk_vect_to_string(tk_run_curve(jr->run), &curve, NULL, err);
+    const tk_curve *c = tk_run_curve(jr->run);
+    size_t ns = 0, nk = 0;
+    const tk_strut *struts = tk_run_struts(jr->run, &ns);
+    const tk_kink *kinks = tk_run_kinks(jr->run, &nk);
+    if (!rc) {
+        json_t *o = tk_json_contacts(c, struts, ns, kinks, nk, true);
+        if (o) {
+            json_object_set_new(o, "step", json_integer((json_int_t)job->latest.step));
+            json_object_set_new(o, "thickness", tk_json_number(job->latest.thickness));
+        }
+        contacts = tk_json_dump(o, false);
+        json_decref(o);
+        hist = history_json(&jr->hist, &job->latest);
+        if (!contacts || !hist)
+            rc = tk_error_set(err, TK_ENOMEM, "out of memory writing job %lld",
+                              (long long)job->id);
+    }
+    size_t nsnap = tk_run_snapshot_count(jr->run);
+    size_t nnew = nsnap - jr->frames_flushed;
+    tk_store_frame *frames = nnew ? calloc(nnew, sizeof *frames) : NULL;
+    if (!rc && nnew && !frames)
+        rc = tk_error_set(err, TK_ENOMEM, "out of memory writing frames");
+    for (size_t i = 0; !rc && i < nnew; i++) {
+        long step = 0;
+        frames[i].xyz = tk_run_snapshot(jr->run, jr->frames_flushed + i, &step);
+        frames[i].step = jr->step_offset + step;
+        frames[i].count = 3 * c->nvert;
+    }
+    if (!rc) {
+        tk_job copy = *job;
+        copy.frames = jr->frames_before + nsnap;
+        rc = tk_store_save(jr->slot->owner->store, &copy, curve, contacts, hist, frames, nnew,
+                           err);
+        if (!rc)
+            jr->frames_flushed = nsnap;
+    }
+    (void)final;
+    free(frames);
+    free(curve);
+    free(contacts);
+    free(hist);
+    return rc;
+}
+
+static int on_step(const tk_step_report *s, void *user)
+{
+    job_run *jr = user;
+    worker_slot *slot = jr->slot;
+    tk_jobs *j = slot->owner;
+    tk_step_report r = *s;
+    r.step += jr->step_offset;
+    r.seconds += jr->seconds_offset;
+    history_add(&jr->hist, &r);
+    if (s->step > 0)
+        atomic_fetch_add(&j->steps_total, 1);
+    pthread_mutex_lock(&j->lock);
+    slot->job.latest = r;
+    slot->job.has_figures = true;
+    slot->job.fraction = job_fraction(&slot->job);
+    slot->job.frames = jr->frames_before + tk_run_snapshot_count(jr->run);
+    tk_job copy = slot->job;
+    bool stop = slot->cancel || j->stopping;
+    pthread_mutex_unlock(&j->lock);
+    double now = now_monotonic();
+    if (now - jr->last_flush >= j->cfg.flush_seconds) {
+        jr->last_flush = now;
+        /* a failed periodic write is retried at the next one; the final
+         * write reports it */
+        if (flush_job(jr, &copy, false, &jr->flush_error) == TK_OK)
+            tk_error_clear(&jr->flush_error);
+    }
+    return stop;
+}
+
+/* Stores the job as failed with a message. */
+static void fail_job(tk_jobs *j, tk_job *job, const char *message)
+{
+    job->state = TK_JOB_FAILED;
+    job->finished = now_unix();
+    snprintf(job->error, sizeof job->error, "%s", message);
+    tk_store_update(j->store, job, NULL);
+}
+
+/* Sets up the engine run for a job: from its stored curve when it was
+ * interrupted (no re-resolution, no rescaling, the step and time budgets
+ * reduced by what was spent), else from its input. */
+static int setup_run(tk_jobs *j, tk_job *job, job_run *jr, tk_error *err)
+{
+    char *text = NULL;
+    size_t len = 0;
+    int rc = tk_store_text(j->store, job->id, TK_TEXT_CURVE, &text, &len, err);
+    bool resume = !rc && text && job->latest.step > 0;
+    if (!rc && !resume) {
+        free(text);
+        text = NULL;
+        rc = tk_store_text(j->store, job->id, TK_TEXT_INPUT, &text, &len, err);
+        if (!rc && !text)
+            rc = tk_error_set(err, TK_EIO, "job %lld has no input", (long long)job->id);
+    }
+    tk_curve *curve = NULL;
+    tk_vect_limits limits = TK_VECT_LIMITS_INIT;
+    limits.max_vertices = j->cfg.max_vertices;
+    if (!rc)
+        rc = tk_vect_parse(text, len, &limits, &curve, err);
+    free(text);
+    tk_options opts;
+    tk_job_options_to_run(&job->options, &opts);
+    if (!rc && resume) {
+        jr->step_offset = job->latest.step;
+        jr->seconds_offset = job->latest.seconds;
+        opts.resolution = 0.0;
+        opts.autoscale = false;
+        if (opts.max_steps > 0)
+            opts.max_steps = opts.max_steps > jr->step_offset ? opts.max_steps - jr->step_offset
+                                                              : 1;
+        if (opts.max_seconds > 0.0)
+            opts.max_seconds = fmax(opts.max_seconds - jr->seconds_offset, 1e-3);
+        char *hist = NULL;
+        if (tk_store_text(j->store, job->id, TK_TEXT_HISTORY, &hist, NULL, NULL) == TK_OK)
+            history_load(&jr->hist, hist);
+        free(hist);
+        jr->frames_before = job->frames;
+    }
+    if (!rc)
+        rc = tk_run_new(curve, &opts, &jr->run, err);
+    tk_curve_free(&curve);
+    return rc;
+}
+
+static void run_job(worker_slot *slot)
+{
+    tk_jobs *j = slot->owner;
+    tk_job job;
+    tk_error err;
+    tk_error_clear(&err);
+    pthread_mutex_lock(&j->lock);
+    job = slot->job;
+    pthread_mutex_unlock(&j->lock);
+
+    job_run jr = {0};
+    jr.slot = slot;
+    jr.hist.cap = j->cfg.history_limit > 2 ? j->cfg.history_limit : 2;
+    jr.hist.items = malloc(jr.hist.cap * sizeof *jr.hist.items);
+    jr.hist.stride = 1;
+    if (!jr.hist.items) {
+        fail_job(j, &job, "out of memory");
+        return;
+    }
+    int rc = setup_run(j, &job, &jr, &err);
+    if (rc) {
+        fail_job(j, &job, err.message);
+        free(jr.hist.items);
+        return;
+    }
+    job.state = TK_JOB_RUNNING;
+    if (job.started <= 0.0)
+        job.started = now_unix();
+    job.components = tk_run_curve(jr.run)->ncomp;
+    pthread_mutex_lock(&j->lock);
+    slot->job = job;
+    slot->run = jr.run;
+    if (slot->cancel || j->stopping)
+        tk_run_cancel(jr.run);
+    pthread_mutex_unlock(&j->lock);
+
+    /* the start's figures (step 0, or the step it resumes from) */
+    on_step(tk_run_latest(jr.run), &jr);
+    pthread_mutex_lock(&j->lock);
+    job = slot->job;
+    pthread_mutex_unlock(&j->lock);
+    jr.last_flush = now_monotonic();
+    flush_job(&jr, &job, false, &err);
+
+    tk_run_set_progress(jr.run, on_step, &jr);
+    tk_stop_reason why = TK_STOP_NONE;
+    rc = tk_run_until(jr.run, &why, &err);
+
+    pthread_mutex_lock(&j->lock);
+    job = slot->job;
+    bool cancelled = slot->cancel;
+    bool stopping = j->stopping;
+    slot->run = NULL;
+    pthread_mutex_unlock(&j->lock);
+
+    snprintf(job.stop_reason, sizeof job.stop_reason, "%s", tk_stop_reason_name(why));
+    if (rc) {
+        job.state = TK_JOB_FAILED;
+        snprintf(job.error, sizeof job.error, "%s", err.message);
+    } else if (why == TK_STOP_CANCELLED && cancelled) {
+        job.state = TK_JOB_CANCELLED;
+    } else if (why == TK_STOP_CANCELLED && stopping) {
+        /* the service is shutting down: the job resumes at the next start */
+        job.state = TK_JOB_QUEUED;
+        job.stop_reason[0] = '\0';
+    } else {
+        job.state = TK_JOB_DONE;
+    }
+    if (tk_job_state_final(job.state))
+        job.finished = now_unix();
+    tk_error werr;
+    if (flush_job(&jr, &job, true, &werr) != TK_OK) {
+        job.state = TK_JOB_FAILED;
+        snprintf(job.error, sizeof job.error, "storing the result failed: %.280s", werr.message);
+        tk_store_update(j->store, &job, NULL);
+    }
+    tk_run_free(&jr.run);
+    free(jr.hist.items);
+}
+
+static void *worker_main(void *arg)
+{
+    worker_slot *slot = arg;
+    tk_jobs *j = slot->owner;
+    /* Workers yield to the threads answering requests, so polling stays
+     * fast however busy the engine is (Linux: per-thread niceness). */
+    setpriority(PRIO_PROCESS, (id_t)syscall(SYS_gettid), 5);
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        while (!j->stopping && j->queue_len == 0)
+            pthread_cond_wait(&j->wake, &j->lock);
+        if (j->stopping) {
+            pthread_mutex_unlock(&j->lock);
+            break;
+        }
+        /* Taking the job and showing it in the slot happen under the one
+         * lock that tk_jobs_cancel also holds, so a cancel either finds it
+         * queued or finds it here. */
+        int64_t id = queue_pop(j);
+        tk_job job;
+        bool take = tk_store_get(j->store, id, &job, NULL) == TK_OK &&
+                    !tk_job_state_final(job.state);
+        if (take) {
+            slot->busy = true;
+            slot->cancel = false;
+            slot->run = NULL;
+            slot->job = job;
+        }
+        pthread_mutex_unlock(&j->lock);
+        if (!take)
+            continue;
+        run_job(slot);
+        pthread_mutex_lock(&j->lock);
+        slot->busy = false;
+        pthread_mutex_unlock(&j->lock);
+    }
+    return NULL;
+}
+
+int tk_jobs_start(tk_store *store, const tk_jobs_config *cfg, tk_jobs **out, tk_error *err)
+{
+    *out = NULL;
+    if (cfg->workers < 1)
+        return tk_error_set(err, TK_EINVAL, "at least one worker is needed");
+    tk_jobs *j = calloc(1, sizeof *j);
+    if (!j)
+        return tk_error_set(err, TK_ENOMEM, "out of memory");
+    j->store = store;
+    j->cfg = *cfg;
+    pthread_mutex_init(&j->lock, NULL);
+    pthread_cond_init(&j->wake, NULL);
+    atomic_init(&j->steps_total, 0);
+    int64_t *ids = NULL;
+    size_t n = 0;
+    int rc = tk_store_unfinished(store, &ids, &n, err);
+    for (size_t i = 0; !rc && i < n; i++)
+        if (!queue_push(j, ids[i]))
+            rc = tk_error_set(err, TK_ENOMEM, "out of memory");
+    free(ids);
+    j->slots = rc ? NULL : calloc(cfg->workers, sizeof *j->slots);
+    if (!rc && !j->slots)
+        rc = tk_error_set(err, TK_ENOMEM, "out of memory");
+    for (size_t i = 0; !rc && i < cfg->workers; i++) {
+        j->slots[i].owner = j;
+        if (pthread_create(&j->slots[i].thread, NULL, worker_main, &j->slots[i]) != 0)
+            rc = tk_error_set(err, TK_ENOMEM, "cannot start worker thread %zu", i + 1);
+        else
+            j->nslots++;
+    }
+    if (rc) {
+        tk_jobs_stop(&j);
+        return rc;
+    }
+    *out = j;
+    return TK_OK;
+}
+
+void tk_jobs_stop(tk_jobs **p)
+{
+    if (!p || !*p)
+        return;
+    tk_jobs *j = *p;
+    pthread_mutex_lock(&j->lock);
+    j->stopping = true;
+    for (size_t i = 0; i < j->nslots; i++)
+        if (j->slots[i].run)
+            tk_run_cancel(j->slots[i].run);
+    pthread_cond_broadcast(&j->wake);
+    pthread_mutex_unlock(&j->lock);
+    for (size_t i = 0; i < j->nslots; i++)
+        pthread_join(j->slots[i].thread, NULL);
+    pthread_cond_destroy(&j->wake);
+    pthread_mutex_destroy(&j->lock);
+    free(j->slots);
+    free(j->queue);
+    free(j);
+    *p = NULL;
+}
+
+int tk_jobs_submit(tk_jobs *j, const char *name, const tk_job_options *opts,
+                   const tk_curve *curve, const char *vect, tk_job *job, tk_error *err)
+{
+    tk_options run_opts;
+    tk_job_options_to_run(opts, &run_opts);
+    /* A run refuses what it cannot start from; finding out here gives the
+     * client a 422 now instead of a failed job later.  Re-resolution is
+     * bounded first, as it decides the memory the check itself takes. */
+    if (curve->nvert > j->cfg.max_vertices)
+        return tk_error_set(err, TK_ELIMIT, "the curve has %zu vertices; the limit is %zu",
+                            curve->nvert, j->cfg.max_vertices);
+    tk_run *probe = NULL;
+    if (opts->resolution > 0.0) {
+        tk_options measure = run_opts;
+        measure.resolution = 0.0;
+        measure.autoscale = true;
+        int rc = tk_run_new(curve, &measure, &probe, err);
+        if (rc)
+            return rc;
+        double wanted = ceil(opts->resolution * tk_run_latest(probe)->ropelength);
+        tk_run_free(&probe);
+        if (!(wanted <= (double)j->cfg.max_vertices))
+            return tk_error_set(err, TK_ELIMIT,
+                                "option 'resolution': %g vertices per unit ropelength make %.0f "
+                                "vertices; the limit is %zu",
+                                opts->resolution, wanted, j->cfg.max_vertices);
+    }
+    int rc = tk_run_new(curve, &run_opts, &probe, err);
+    if (rc)
+        return rc;
+    tk_run_free(&probe);
+
+    memset(job, 0, sizeof *job);
+    snprintf(job->name, sizeof job->name, "%s", name);
+    job->state = TK_JOB_QUEUED;
+    job->options = *opts;
+    if (job->options.steps == 0 && job->options.time == 0.0 && job->options.residual == 0.0)
+        job->options.steps = TK_JOB_DEFAULT_STEPS;
+    job->created = now_unix();
+    job->fraction = -1.0;
+    job->components = curve->ncomp;
+    job->latest.vertices = curve->nvert;
+    pthread_mutex_lock(&j->lock);
+    if (j->stopping) {
+        pthread_mutex_unlock(&j->lock);
+        return tk_error_set(err, TK_EBUSY, "the service is shutting down");
+    }
+    if (j->queue_len >= j->cfg.queue_limit) {
+        pthread_mutex_unlock(&j->lock);
+        return tk_error_set(err, TK_EBUSY, "the queue is full (%zu jobs waiting)",
+                            j->cfg.queue_limit);
+    }
+    rc = tk_store_insert(j->store, job, vect, err);
+    if (!rc)
+        rc = tk_store_update(j->store, job, err);
+    if (!rc && !queue_push(j, job->id))
+        rc = tk_error_set(err, TK_ENOMEM, "out of memory");
+    if (!rc)
+        pthread_cond_signal(&j->wake);
+    pthread_mutex_unlock(&j->lock);
+    return rc;
+}
+
+int tk_jobs_get(tk_jobs *j, int64_t id, tk_job *out, tk_error *err)
+{
+    pthread_mutex_lock(&j->lock);
+    worker_slot *slot = slot_of(j, id);
+    if (slot)
+        *out = slot->job;
+    pthread_mutex_unlock(&j->lock);
+    return slot ? TK_OK : tk_store_get(j->store, id, out, err);
+}
+
+int tk_jobs_cancel(tk_jobs *j, int64_t id, tk_job *out, tk_error *err)
+{
+    pthread_mutex_lock(&j->lock);
+    worker_slot *slot = slot_of(j, id);
+    if (slot) {
+        slot->cancel = true;
+        if (slot->run)
+            tk_run_cancel(slot->run);
+        *out = slot->job;
+        pthread_mutex_unlock(&j->lock);
+        return TK_OK;
+    }
+    /* Not running: read and change it while holding the lock, so that no
+     * worker takes it up in between. */
+    int rc = tk_store_get(j->store, id, out, err);
+    if (!rc && tk_job_state_final(out->state))
+        rc = tk_error_set(err, TK_EINVAL, "job %lld has already finished (%s)", (long long)id,
+                          tk_job_state_name(out->state));
+    if (!rc) {
+        queue_remove(j, id);
+        out->state = TK_JOB_CANCELLED;
+        out->finished = now_unix();
+        snprintf(out->stop_reason, sizeof out->stop_reason, "cancelled");
+        rc = tk_store_update(j->store, out, err);
+    }
+    pthread_mutex_unlock(&j->lock);
+    return rc;
+}
+
+void tk_jobs_stats_get(tk_jobs *j, tk_jobs_stats *out)
+{
+    memset(out, 0, sizeof *out);
+    pthread_mutex_lock(&j->lock);
+    out->queued = j->queue_len;
+    out->workers = j->nslots;
+    out->queue_limit = j->cfg.queue_limit;
+    for (size_t i = 0; i < j->nslots; i++) {
+        const worker_slot *s = &j->slots[i];
+        if (!s->busy)
+            continue;
+        out->running++;
+        if (s->run && s->job.latest.seconds > 0.0 && s->job.latest.step > 0)
+            out->steps_per_second += (double)s->job.latest.step / s->job.latest.seconds;
+    }
+    pthread_mutex_unlock(&j->lock);
+    out->steps_total = atomic_load(&j->steps_total);
+}

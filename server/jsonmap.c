@@ -1,0 +1,162 @@
+/* tightknot: JSON forms of the engine's results (see include/tk/jsonmap.h). */
+#include "tk/jsonmap.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+json_t *tk_json_number(double x)
+{
+    return isfinite(x) ? json_real(x) : json_null();
+}
+
+json_t *tk_json_point(const double p[3])
+{
+    json_t *a = json_array();
+    for (int k = 0; a && k < 3; k++)
+        json_array_append_new(a, tk_json_number(p[k]));
+    return a;
+}
+
+json_t *tk_json_text(const char *s)
+{
+    json_t *j = json_string(s);
+    if (j)
+        return j;
+    char *copy = strdup(s);
+    if (!copy)
+        return NULL;
+    for (char *p = copy; *p; p++)
+        if ((unsigned char)*p >= 0x80)
+            *p = '?';
+    j = json_string(copy);
+    free(copy);
+    return j;
+}
+
+json_t *tk_json_step(const tk_step_report *s)
+{
+    json_t *o = json_object();
+    if (!o)
+        return NULL;
+    json_object_set_new(o, "step", json_integer((json_int_t)s->step));
+    json_object_set_new(o, "seconds", tk_json_number(s->seconds));
+    json_object_set_new(o, "ropelength", tk_json_number(s->ropelength));
+    json_object_set_new(o, "length", tk_json_number(s->length));
+    json_object_set_new(o, "thickness", tk_json_number(s->thickness));
+    json_object_set_new(o, "minrad", tk_json_number(s->minrad));
+    json_object_set_new(o, "residual", tk_json_number(s->residual));
+    json_object_set_new(o, "struts", json_integer((json_int_t)s->struts));
+    json_object_set_new(o, "kinks", json_integer((json_int_t)s->kinks));
+    json_object_set_new(o, "step_size", tk_json_number(s->step_size));
+    json_object_set_new(o, "rcond", tk_json_number(s->rcond));
+    json_object_set_new(o, "violation", tk_json_number(s->violation));
+    json_object_set_new(o, "corrections", json_integer(s->corrections));
+    json_object_set_new(o, "vertices", json_integer((json_int_t)s->vertices));
+    return o;
+}
+
+/* Arclength at the start of every edge, components laid end to end:
+ * start[e] for global edge e, plus each component's start in comp_start. */
+static double *edge_starts(const tk_curve *c, double *comp_start)
+{
+    size_t ne = tk_curve_edge_count(c);
+    double *start = malloc((ne + 1) * sizeof *start);
+    if (!start)
+        return NULL;
+    double s = 0.0;
+    size_t e = 0;
+    for (size_t comp = 0; comp < c->ncomp; comp++) {
+        comp_start[comp] = s;
+        size_t n = tk_curve_comp_edges(c, comp);
+        for (size_t k = 0; k < n; k++, e++) {
+            start[e] = s;
+            s += tk_curve_edge_length(c, comp, k);
+        }
+    }
+    start[e] = s;
+    return start;
+}
+
+json_t *tk_json_contacts(const tk_curve *c, const tk_strut *struts, size_t nstruts,
+                         const tk_kink *kinks, size_t nkinks, bool with_force)
+{
+    double *comp_start = malloc((c->ncomp + 1) * sizeof *comp_start);
+    double *start = comp_start ? edge_starts(c, comp_start) : NULL;
+    json_t *o = json_object();
+    json_t *comps = json_array();
+    json_t *list = json_array();
+    json_t *klist = json_array();
+    if (!start || !o || !comps || !list || !klist) {
+        free(comp_start);
+        free(start);
+        json_decref(o);
+        json_decref(comps);
+        json_decref(list);
+        json_decref(klist);
+        return NULL;
+    }
+    for (size_t comp = 0; comp < c->ncomp; comp++)
+        json_array_append_new(comps,
+                              json_pack("{s:I, s:b, s:o, s:o}", "vertices",
+                                        (json_int_t)tk_curve_comp_vertices(c, comp), "closed",
+                                        c->closed[comp], "length",
+                                        tk_json_number(tk_curve_comp_length(c, comp)), "start",
+                                        tk_json_number(comp_start[comp])));
+    for (size_t i = 0; i < nstruts; i++) {
+        const tk_strut *st = &struts[i];
+        double along[2];
+        double param[2] = {st->s, st->t};
+        for (int k = 0; k < 2; k++) {
+            size_t e = tk_curve_comp_first_edge(c, st->comp[k]) + st->edge[k];
+            along[k] = start[e] + param[k] * (start[e + 1] - start[e]);
+        }
+        json_t *j = json_object();
+        json_object_set_new(j, "edges",
+                            json_pack("[[II][II]]", (json_int_t)st->comp[0],
+                                      (json_int_t)st->edge[0], (json_int_t)st->comp[1],
+                                      (json_int_t)st->edge[1]));
+        json_object_set_new(j, "s", tk_json_number(st->s));
+        json_object_set_new(j, "t", tk_json_number(st->t));
+        json_object_set_new(j, "p", tk_json_point(st->p));
+        json_object_set_new(j, "q", tk_json_point(st->q));
+        json_object_set_new(j, "length", tk_json_number(st->length));
+        json_object_set_new(j, "arclength",
+                            json_pack("[o, o]", tk_json_number(along[0]),
+                                      tk_json_number(along[1])));
+        if (with_force)
+            json_object_set_new(j, "force", tk_json_number(st->force));
+        json_array_append_new(list, j);
+    }
+    for (size_t i = 0; i < nkinks; i++) {
+        const tk_kink *k = &kinks[i];
+        size_t e = tk_curve_comp_first_edge(c, k->comp) + k->vertex;
+        json_t *j = json_object();
+        json_object_set_new(j, "comp", json_integer((json_int_t)k->comp));
+        json_object_set_new(j, "vertex", json_integer((json_int_t)k->vertex));
+        json_object_set_new(j, "minrad", tk_json_number(k->minrad));
+        /* the vertex starts edge `vertex` of its component; the last
+         * vertex of an open one ends the component */
+        json_object_set_new(j, "arclength", tk_json_number(
+                                                k->vertex < tk_curve_comp_edges(c, k->comp)
+                                                    ? start[e]
+                                                    : comp_start[k->comp] +
+                                                          tk_curve_comp_length(c, k->comp)));
+        if (with_force)
+            json_object_set_new(j, "force", tk_json_number(k->force));
+        json_array_append_new(klist, j);
+    }
+    json_object_set_new(o, "components", comps);
+    json_object_set_new(o, "struts", list);
+    json_object_set_new(o, "kinks", klist);
+    free(start);
+    free(comp_start);
+    return o;
+}
+
+char *tk_json_dump(const json_t *value, bool indent)
+{
+    size_t flags = JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17) |
+                   (indent ? JSON_INDENT(1) : JSON_COMPACT);
+    return value ? json_dumps(value, flags) : NULL;
+}
