@@ -61,7 +61,7 @@ BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
 .SECONDARY:
 
-.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten \
+.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-service \
 	lint headers clean
 
 all: $(LIB) $(CLI) $(DAEMON)
@@ -111,18 +111,26 @@ tests-bin: $(TEST_BIN)
 test-unit: all $(TEST_BIN)
 	$(Q)./tests/run-all.sh --unit-only $(BUILD) "" $(CATALOGUE)
 
-run: deps all
-	@echo "The service (tightknotd) is not built yet: 'make run' will start it"
-	@echo "on http://127.0.0.1:8080/ once it exists.  Meanwhile try:"
-	@echo "  $(CLI) info $(CATALOGUE)/3.1.vect"
+# The service on its defaults: 127.0.0.1:8080, jobs in var/tightknot.db,
+# the catalogue when ../shared/catalogue is there, the page from web/.
+PORT ?= 8080
+RUN_ARGS = --port $(PORT) --db var/tightknot.db $(if $(wildcard $(CATALOGUE)/*.vect),--catalogue $(CATALOGUE)) $(if $(wildcard web/index.html),--web web)
 
-bench: bench-struts bench-tighten
+run: deps all
+	@mkdir -p var
+	@echo "tightknot: starting the service on http://127.0.0.1:$(PORT)/ (Ctrl-C stops it)"
+	$(Q)exec $(DAEMON) $(RUN_ARGS)
+
+bench: bench-struts bench-tighten bench-service
 
 bench-struts: deps all $(BENCH_BIN)
 	$(Q)$(BUILD)/bench/struts $(CATALOGUE)
 
 bench-tighten: deps all $(BENCH_BIN)
 	$(Q)$(BUILD)/bench/tighten $(CATALOGUE)
+
+bench-service: deps all
+	$(Q)./bench/service.sh $(BUILD) $(CATALOGUE)
 
 # Banned unsafe calls (curl's list).
 lint:

@@ -2,7 +2,8 @@
 # Installs the Debian packages tightknot needs, quietly when all are there.
 set -eu
 packages="build-essential pkg-config check clang libsuitesparse-dev liblapack-dev
-libblas-dev libjansson-dev libmicrohttpd-dev libsqlite3-dev libcurl4-openssl-dev"
+libblas-dev libjansson-dev libmicrohttpd-dev libsqlite3-dev libcurl4-openssl-dev
+wrk sqlite3 curl"
 missing=""
 for p in $packages; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
