@@ -28,6 +28,7 @@
 #include "tk/curve.h"
 #include "tk/error.h"
 #include "tk/generate.h"
+#include "tk/jsonmap.h"
 #include "tk/struts.h"
 #include "tk/thickness.h"
 #include "tk/tighten.h"
@@ -497,38 +498,6 @@ static const char *input_path(const char *name)
     return strcmp(name, "-") == 0 ? "/dev/stdin" : name;
 }
 
-/* A JSON number, or null for inf/nan (JSON has no such numbers). */
-static json_t *json_number(double x)
-{
-    return isfinite(x) ? json_real(x) : json_null();
-}
-
-/* A JSON string; a name that is not UTF-8 keeps its ASCII bytes and shows
- * '?' for the others, since JSON text must be Unicode. */
-static json_t *json_name(const char *s)
-{
-    json_t *j = json_string(s);
-    if (j)
-        return j;
-    char *copy = strdup(s);
-    if (!copy)
-        return NULL;
-    for (char *p = copy; *p; p++)
-        if ((unsigned char)*p >= 0x80)
-            *p = '?';
-    j = json_string(copy);
-    free(copy);
-    return j;
-}
-
-static json_t *json_point(const double x[3])
-{
-    json_t *a = json_array();
-    for (int k = 0; k < 3; k++)
-        json_array_append_new(a, json_number(x[k]));
-    return a;
-}
-
 /* Prints a JSON value on one line, numbers with 17 significant digits so
  * that they read back as the same doubles.  Takes the reference. */
 static int print_json(json_t *value)
@@ -600,13 +569,13 @@ static int info_one(const char *name, const cli_args *a, int width, bool *header
         return status;
     if (a->json) {
         json_t *o = json_object();
-        json_object_set_new(o, "file", json_name(name));
+        json_object_set_new(o, "file", tk_json_text(name));
         json_object_set_new(o, "components", json_integer((json_int_t)c->ncomp));
         json_object_set_new(o, "vertices", json_integer((json_int_t)c->nvert));
-        json_object_set_new(o, "length", json_number(m.length));
-        json_object_set_new(o, "thickness", json_number(m.thickness));
-        json_object_set_new(o, "minrad", json_number(m.minrad));
-        json_object_set_new(o, "ropelength", json_number(m.ropelength));
+        json_object_set_new(o, "length", tk_json_number(m.length));
+        json_object_set_new(o, "thickness", tk_json_number(m.thickness));
+        json_object_set_new(o, "minrad", tk_json_number(m.minrad));
+        json_object_set_new(o, "ropelength", tk_json_number(m.ropelength));
         json_object_set_new(o, "struts", json_integer((json_int_t)struts.count));
         json_object_set_new(o, "kinks", json_integer((json_int_t)nkinks));
         status = print_json(o);
@@ -683,41 +652,23 @@ static void print_struts_text(const char *name, const tk_measure *m, const tk_st
         printf("%6zu %6zu %8zu %12.9f\n", i, kinks[i].comp, kinks[i].vertex, kinks[i].minrad);
 }
 
-static json_t *struts_json(const char *name, const tk_measure *m, const tk_strut_list *s,
-                           const tk_kink *kinks, size_t nkinks, bool with_force)
+/* The contacts document of `tightknot struts` and `tighten --struts`: the
+ * service's strut list (tk_json_contacts) with the file and thickness. */
+static json_t *struts_json(const char *name, const tk_curve *c, double thickness,
+                           const tk_strut *struts, size_t nstruts, const tk_kink *kinks,
+                           size_t nkinks, bool with_force)
 {
     json_t *o = json_object();
-    json_t *list = json_array();
-    for (size_t i = 0; i < s->count; i++) {
-        const tk_strut *st = &s->items[i];
-        json_t *j = json_object();
-        json_object_set_new(j, "edges",
-                            json_pack("[[II][II]]", (json_int_t)st->comp[0],
-                                      (json_int_t)st->edge[0], (json_int_t)st->comp[1],
-                                      (json_int_t)st->edge[1]));
-        json_object_set_new(j, "s", json_number(st->s));
-        json_object_set_new(j, "t", json_number(st->t));
-        json_object_set_new(j, "p", json_point(st->p));
-        json_object_set_new(j, "q", json_point(st->q));
-        json_object_set_new(j, "length", json_number(st->length));
-        if (with_force)
-            json_object_set_new(j, "force", json_number(st->force));
-        json_array_append_new(list, j);
+    json_t *contacts = tk_json_contacts(c, struts, nstruts, kinks, nkinks, with_force);
+    if (!o || !contacts) {
+        json_decref(o);
+        json_decref(contacts);
+        return NULL;
     }
-    json_t *klist = json_array();
-    for (size_t i = 0; i < nkinks; i++) {
-        json_t *j = json_object();
-        json_object_set_new(j, "comp", json_integer((json_int_t)kinks[i].comp));
-        json_object_set_new(j, "vertex", json_integer((json_int_t)kinks[i].vertex));
-        json_object_set_new(j, "minrad", json_number(kinks[i].minrad));
-        if (with_force)
-            json_object_set_new(j, "force", json_number(kinks[i].force));
-        json_array_append_new(klist, j);
-    }
-    json_object_set_new(o, "file", json_name(name));
-    json_object_set_new(o, "thickness", json_number(m->thickness));
-    json_object_set_new(o, "struts", list);
-    json_object_set_new(o, "kinks", klist);
+    json_object_set_new(o, "file", tk_json_text(name));
+    json_object_set_new(o, "thickness", tk_json_number(thickness));
+    json_object_update(o, contacts);
+    json_decref(contacts);
     return o;
 }
 
@@ -742,7 +693,8 @@ static int cmd_struts(int argc, char **argv)
     if (status)
         return status;
     if (a.json)
-        status = print_json(struts_json(name, &m, &struts, kinks, nkinks, false));
+        status = print_json(struts_json(name, c, m.thickness, struts.items, struts.count, kinks,
+                                        nkinks, false));
     else
         print_struts_text(name, &m, &struts, kinks, nkinks, a.tolerance);
     tk_strut_list_free(&struts);
@@ -875,15 +827,12 @@ static int tighten_progress(const tk_step_report *s, void *user)
 
 static int write_struts_file(const char *path, const char *name, tk_run *run)
 {
-    const tk_step_report *last = tk_run_latest(run);
-    tk_measure m = {last->length, last->minrad, NAN, last->thickness, last->ropelength};
     size_t ns = 0, nk = 0;
     const tk_strut *st = tk_run_struts(run, &ns);
     const tk_kink *kinks = tk_run_kinks(run, &nk);
-    tk_strut_list list = {(tk_strut *)st, ns, ns};
-    json_t *o = struts_json(name, &m, &list, kinks, nk, true);
-    char *text = o ? json_dumps(o, JSON_INDENT(1) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17))
-                   : NULL;
+    json_t *o = struts_json(name, tk_run_curve(run), tk_run_latest(run)->thickness, st, ns,
+                            kinks, nk, true);
+    char *text = tk_json_dump(o, true);
     json_decref(o);
     FILE *f = text ? fopen(path, "w") : NULL;
     int ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
@@ -963,16 +912,16 @@ static int cmd_tighten(int argc, char **argv)
     const tk_curve *fin = tk_run_curve(run);
     if (a.json) {
         json_t *o = json_object();
-        json_object_set_new(o, "file", json_name(name));
-        json_object_set_new(o, "ropelength", json_number(last->ropelength));
-        json_object_set_new(o, "length", json_number(last->length));
-        json_object_set_new(o, "thickness", json_number(last->thickness));
-        json_object_set_new(o, "minrad", json_number(last->minrad));
+        json_object_set_new(o, "file", tk_json_text(name));
+        json_object_set_new(o, "ropelength", tk_json_number(last->ropelength));
+        json_object_set_new(o, "length", tk_json_number(last->length));
+        json_object_set_new(o, "thickness", tk_json_number(last->thickness));
+        json_object_set_new(o, "minrad", tk_json_number(last->minrad));
         json_object_set_new(o, "vertices", json_integer((json_int_t)fin->nvert));
         json_object_set_new(o, "components", json_integer((json_int_t)fin->ncomp));
         json_object_set_new(o, "steps", json_integer((json_int_t)last->step));
-        json_object_set_new(o, "seconds", json_number(last->seconds));
-        json_object_set_new(o, "residual", json_number(last->residual));
+        json_object_set_new(o, "seconds", tk_json_number(last->seconds));
+        json_object_set_new(o, "residual", tk_json_number(last->residual));
         json_object_set_new(o, "struts", json_integer((json_int_t)last->struts));
         json_object_set_new(o, "kinks", json_integer((json_int_t)last->kinks));
         json_object_set_new(o, "stop_reason", json_string(tk_stop_reason_name(why)));
