@@ -84,7 +84,7 @@ $(SERVER_LIB): $(SERVER_OBJ)
 
 $(CLI): $(CLI_OBJ) $(SERVER_LIB) $(LIB)
 	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(SERVER_LIB) $(LIB) $(SERVER_LIBS) $(LDLIBS)
+	$(Q)$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(SERVER_LIB) $(LIB) $(SERVER_LIBS) -lcurl $(LDLIBS)
 
 $(DAEMON): $(BUILD)/server/tightknotd.o $(SERVER_LIB) $(LIB)
 	@$(if $(Q),echo "  LD      $@")

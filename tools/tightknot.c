@@ -5,6 +5,7 @@
  *   tightknot generate torus P Q | hopf | borromean | chain K [--vertices N]
  *   tightknot tighten FILE [run options] [-o OUT] [--struts OUT] [--log OUT]
  *                    [--snapshots DIR --every K] [--json]
+ *   tightknot remote [--server URL] submit|status|cancel|fetch ...
  *
  * One static function per subcommand; options are parsed by one shared
  * helper that knows which options each subcommand accepts.  Options may
@@ -33,6 +34,8 @@
 #include "tk/thickness.h"
 #include "tk/tighten.h"
 #include "tk/vect.h"
+
+#include "remote.h"
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -945,6 +948,11 @@ done:
     return status;
 }
 
+static int cmd_remote(int argc, char **argv)
+{
+    return tk_remote_main(argc, argv);
+}
+
 static int cmd_help(int argc, char **argv)
 {
     if (argc == 0) {
@@ -961,6 +969,8 @@ static int cmd_help(int argc, char **argv)
         fputs(generate_help, stdout);
     else if (strcmp(argv[0], "tighten") == 0)
         fputs(tighten_help, stdout);
+    else if (strcmp(argv[0], "remote") == 0)
+        fputs(tk_remote_help, stdout);
     else if (strcmp(argv[0], "help") == 0)
         fputs(main_help, stdout);
     else
@@ -980,6 +990,7 @@ static const command commands[] = {
     {"struts", cmd_struts},
     {"generate", cmd_generate},
     {"tighten", cmd_tighten},
+    {"remote", cmd_remote},
     {"help", cmd_help},
 };
 

@@ -1,0 +1,157 @@
+#!/bin/sh
+# Tests of `tightknot remote` against a live tightknotd on loopback: a
+# directory of generated knots and catalogue files is tightened with a
+# small step budget; the summary has one row per file and its figures are
+# the server's job records; a second run submits nothing; a refused file
+# and a dead server give clear errors and non-zero exits.
+#   TK_BUILD=build TK_CATALOGUE=../shared/catalogue sh tests/cli-remote.sh
+# Ends with "cli-remote: N passed, M failed".
+set -u
+build=${TK_BUILD:-build}
+catalogue=${TK_CATALOGUE:-}
+tk=$build/tightknot
+
+passed=0
+failed=0
+tmp=$(mktemp -d)
+pid=""
+cleanup() {
+    [ -n "$pid" ] && kill "$pid" 2>/dev/null && wait "$pid" 2>/dev/null
+    rm -rf "$tmp"
+}
+trap cleanup EXIT
+trap 'exit 1' INT TERM
+
+pass() { passed=$((passed + 1)); }
+fail() {
+    failed=$((failed + 1))
+    echo "FAIL $*"
+}
+summary() {
+    echo "cli-remote: $passed passed, $failed failed"
+    [ "$failed" -eq 0 ]
+    exit
+}
+check() { # check CONDITION-STATUS WHAT
+    if [ "$1" -eq 0 ]; then pass; else fail "$2"; fi
+}
+
+# a server on a free port with a fresh store
+"$build/tightknotd" --port 0 --db "$tmp/jobs.db" --workers 2 >"$tmp/daemon.log" 2>&1 &
+pid=$!
+port=""
+for _ in $(seq 50); do
+    port=$(sed -n 's|.*http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$tmp/daemon.log")
+    [ -n "$port" ] && break
+    sleep 0.1
+done
+if [ -z "$port" ]; then
+    fail "the daemon did not start: $(cat "$tmp/daemon.log")"
+    summary
+fi
+url="http://127.0.0.1:$port"
+
+mkdir -p "$tmp/in"
+"$tk" generate torus 2 3 --vertices 60 >"$tmp/in/trefoil.vect"
+"$tk" generate hopf --vertices 48 >"$tmp/in/hopf.vect"
+"$tk" generate chain 3 --vertices 90 >"$tmp/in/chain3.vect"
+files=3
+if [ -n "$catalogue" ] && [ -f "$catalogue/3.1.vect" ]; then
+    cp "$catalogue/3.1.vect" "$catalogue/2.2.1.vect" "$catalogue/0.2.1.vect" "$tmp/in/"
+    files=6
+fi
+
+"$tk" remote --server "$url" submit --autoscale --steps 60 --parallel 3 --poll 0.2 \
+    --out "$tmp/out" "$tmp/in" >"$tmp/stdout" 2>"$tmp/stderr"
+check $? "submit exits 0: $(tail -n 3 "$tmp/stderr")"
+rows=$(($(wc -l <"$tmp/out/summary.tsv") - 1))
+[ "$rows" -eq "$files" ]
+check $? "summary has $rows rows for $files files"
+head -n 1 "$tmp/out/summary.tsv" | grep -q "^name	components	vertices	ropelength	thickness	residual	struts	steps	seconds	state$"
+check $? "summary header: $(head -n 1 "$tmp/out/summary.tsv")"
+
+# every row is the server's own record of that file's job
+tail -n +2 "$tmp/out/summary.tsv" >"$tmp/rows"
+while IFS="	" read -r name comps verts rope thick resid struts steps secs state; do
+    [ "$state" = done ]
+    check $? "$name: state $state"
+    [ "$steps" = 60 ]
+    check $? "$name: $steps steps, want 60"
+    id=$(awk -F"	" -v n="$name" '$1 == n {print $2}' "$tmp/out/jobs.tsv" | tail -n 1)
+    curl -sf "$url/v1/jobs/$id" >"$tmp/job.json"
+    check $? "$name: GET /v1/jobs/$id"
+    for field in ropelength thickness residual; do
+        eval "mine=\$$(echo $field | sed 's/ropelength/rope/; s/thickness/thick/; s/residual/resid/')"
+        theirs=$(sed -n "s/.*\"$field\":\([^,}]*\).*/\1/p" "$tmp/job.json")
+        awk -v a="$mine" -v b="$theirs" 'BEGIN { exit !(a == b && a + 0 > 0) }'
+        check $? "$name: $field $mine in the summary, $theirs on the server"
+    done
+    grep -q "\"name\":\"$name\"" "$tmp/job.json"
+    check $? "$name: job $id is named $name"
+    [ -s "$tmp/out/$name.vect" ] && "$tk" info "$tmp/out/$name.vect" --json >"$tmp/info.json"
+    check $? "$name: the downloaded VECT reads back"
+    info_rope=$(sed -n 's/.*"ropelength":\([^,}]*\).*/\1/p' "$tmp/info.json")
+    awk -v a="$info_rope" -v b="$rope" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= 1e-9 * b) }'
+    check $? "$name: tightknot info on the download gives $info_rope, the job $rope"
+    grep -q '"struts":\[' "$tmp/out/$name.struts.json"
+    check $? "$name: struts JSON downloaded"
+done <"$tmp/rows"
+
+# a second run submits nothing new
+before=$(curl -sf "$url/v1/jobs?limit=1" | sed -n 's/.*"total":\([0-9]*\).*/\1/p')
+"$tk" remote --server "$url" submit --autoscale --steps 60 --poll 0.2 --out "$tmp/out" \
+    "$tmp/in" >/dev/null 2>"$tmp/stderr2"
+check $? "second run exits 0"
+after=$(curl -sf "$url/v1/jobs?limit=1" | sed -n 's/.*"total":\([0-9]*\).*/\1/p')
+[ "$before" = "$after" ] && [ -n "$before" ]
+check $? "second run submitted $((after - before)) jobs, want 0"
+rows2=$(($(wc -l <"$tmp/out/summary.tsv") - 1))
+[ "$rows2" -eq "$files" ]
+check $? "summary keeps $rows2 rows"
+
+# a refused file: its row says so, the others are still written, exit 2
+printf 'VECT\n1 3 0\n-3\n0\n0 0 0\n1 0 nope\n0 1 0\n' >"$tmp/in/broken.vect"
+"$tk" remote --server "$url" submit --autoscale --steps 60 --poll 0.2 --out "$tmp/out" \
+    "$tmp/in" >/dev/null 2>"$tmp/stderr3"
+[ $? -eq 2 ]
+check $? "a refused file makes the exit status 2"
+grep -q "broken: refused: line 6" "$tmp/stderr3"
+check $? "the refusal names the line: $(cat "$tmp/stderr3")"
+grep -q "^broken	.*	refused$" "$tmp/out/summary.tsv"
+check $? "the refused file has its row"
+[ $(($(wc -l <"$tmp/out/summary.tsv") - 1)) -eq $((files + 1)) ]
+check $? "the done rows are kept next to the refused one"
+
+# status, fetch and cancel of single jobs
+first=$(head -n 1 "$tmp/out/jobs.tsv" | cut -f 2)
+"$tk" remote --server "$url" status "$first" >"$tmp/status" 2>&1
+check $? "status exits 0"
+grep -q "^$first	.*	done	step 60	" "$tmp/status"
+check $? "status line: $(cat "$tmp/status")"
+"$tk" remote --server "$url" fetch --out "$tmp/fetched" "$first" >/dev/null 2>&1 &&
+    cmp -s "$tmp/fetched/job-$first.vect" "$tmp/out/$(head -n 1 "$tmp/out/jobs.tsv" | cut -f 1).vect"
+check $? "fetch downloads the same VECT"
+"$tk" remote --server "$url" cancel "$first" >/dev/null 2>"$tmp/cancel"
+[ $? -eq 2 ] && grep -q "already finished" "$tmp/cancel"
+check $? "cancelling a finished job: $(cat "$tmp/cancel")"
+"$tk" remote --server "$url" status 999999 >/dev/null 2>"$tmp/missing"
+[ $? -eq 2 ] && grep -q "no job 999999" "$tmp/missing"
+check $? "status of a missing job: $(cat "$tmp/missing")"
+
+# a dead server: a clear message and exit 3
+kill "$pid" && wait "$pid" 2>/dev/null
+pid=""
+"$tk" remote --server "$url" submit --steps 5 --out "$tmp/out2" "$tmp/in/hopf.vect" \
+    >/dev/null 2>"$tmp/dead"
+[ $? -eq 3 ]
+check $? "a dead server makes the exit status 3"
+grep -q "cannot reach $url" "$tmp/dead"
+check $? "a dead server is named: $(cat "$tmp/dead")"
+"$tk" remote --server "ftp://x" status 1 >/dev/null 2>&1
+[ $? -eq 1 ]
+check $? "a non-http URL is a usage error"
+"$tk" remote submit --steps -1 x >/dev/null 2>"$tmp/usage"
+[ $? -eq 1 ] && grep -q "option 'steps'" "$tmp/usage"
+check $? "a bad run option is a usage error naming it: $(cat "$tmp/usage")"
+
+summary

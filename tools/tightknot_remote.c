@@ -1,0 +1,955 @@
+/* tightknot remote: submits knots to a tightknot service, follows the
+ * jobs, downloads the results and keeps a summary table; also status,
+ * cancel and fetch of single jobs.  Talks only the public HTTP API
+ * (openapi.yaml) through libcurl.
+ *
+ * Resuming: DIR/jobs.tsv records every submitted file's job id as soon as
+ * the server accepts it, and DIR/summary.tsv every finished file.  A second
+ * run skips the files already in the summary as done and follows the jobs
+ * already submitted instead of submitting them again.
+ */
+#include "remote.h"
+
+#include <curl/curl.h>
+#include <dirent.h>
+#include <errno.h>
+#include <jansson.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "tk/jobspec.h"
+
+enum { REMOTE_OK = 0, REMOTE_USAGE = 1, REMOTE_FAILED = 2, REMOTE_SERVER = 3 };
+
+const char tk_remote_help[] =
+    "usage: tightknot remote [--server URL] COMMAND ...\n"
+    "\n"
+    "Uses a tightknot service (tightknotd) over HTTP.\n"
+    "\n"
+    "Commands:\n"
+    "  submit [run options] [--out DIR] [--parallel N] FILES... | DIR\n"
+    "      tighten every VECT file (a directory stands for its *.vect files):\n"
+    "      submits them, at most N running at once (default 4), shows their\n"
+    "      progress, and downloads each result into DIR (default\n"
+    "      tightknot-results): NAME.vect (the tight curve), NAME.struts.json\n"
+    "      (struts and kinks) and a row of DIR/summary.tsv with name,\n"
+    "      components, vertices, ropelength, thickness, residual, struts, steps,\n"
+    "      seconds, state.  Run it again to resume: files already done are not\n"
+    "      submitted again and jobs already submitted are followed.\n"
+    "  status JOB...   one line per job: state, step, ropelength, residual\n"
+    "  cancel JOB...   cancel queued or running jobs\n"
+    "  fetch [--out DIR] JOB...   download jobs' VECT and struts into DIR\n"
+    "\n"
+    "Run options (as for tightknot tighten): --resolution R, --steps N,\n"
+    "--time SECONDS, --residual X, --radius R, --lambda L, --autoscale,\n"
+    "--every K (keep a frame every K steps).  With none of steps, time and\n"
+    "residual a job stops after 1000 steps.\n"
+    "\n"
+    "Options:\n"
+    "  --server URL   the service (default $TIGHTKNOT_SERVER, else\n"
+    "                 http://127.0.0.1:8080)\n"
+    "  --poll SECONDS how often to ask for progress (default 1)\n"
+    "  --json         status: print the jobs as JSON, one per line\n"
+    "\n"
+    "Exit status: 0 all done, 1 usage error, 2 some job failed or a file was\n"
+    "refused, 3 the server could not be reached or answered with an error.\n"
+    "\n"
+    "Example (the whole catalogue on a remote server):\n"
+    "  tightknot remote --server http://tk.example.org:8080 submit \\\n"
+    "      --resolution 5 --time 300 --out results ../shared/catalogue\n";
+
+/* ------------------------------------------------------------ HTTP */
+
+typedef struct buffer {
+    char *data;
+    size_t len, cap;
+} buffer;
+
+typedef struct client {
+    CURL *curl;
+    char base[1024];
+    char error[CURL_ERROR_SIZE];
+    bool tty;
+} client;
+
+typedef struct response {
+    long status;
+    buffer body;
+    double retry_after;
+} response;
+
+static size_t collect(char *data, size_t size, size_t n, void *user)
+{
+    buffer *b = user;
+    size_t add = size * n;
+    if (b->len + add + 1 > b->cap) {
+        size_t cap = b->cap ? 2 * b->cap : 4096;
+        while (cap < b->len + add + 1)
+            cap *= 2;
+        char *grown = realloc(b->data, cap);
+        if (!grown)
+            return 0;
+        b->data = grown;
+        b->cap = cap;
+    }
+    memcpy(b->data + b->len, data, add);
+    b->len += add;
+    b->data[b->len] = '\0';
+    return add;
+}
+
+static size_t header_line(char *data, size_t size, size_t n, void *user)
+{
+    response *r = user;
+    size_t len = size * n;
+    if (len > 12 && strncasecmp(data, "Retry-After:", 12) == 0)
+        r->retry_after = strtod(data + 12, NULL);
+    return len;
+}
+
+/* One request; false (message printed) when the server cannot be reached. */
+static bool request(client *c, const char *method, const char *path, const char *type,
+                    const char *body, size_t len, response *r)
+{
+    free(r->body.data);
+    memset(r, 0, sizeof *r);
+    char url[2048];
+    snprintf(url, sizeof url, "%s%s", c->base, path);
+    CURL *h = c->curl;
+    curl_easy_reset(h);
+    curl_easy_setopt(h, CURLOPT_URL, url);
+    curl_easy_setopt(h, CURLOPT_CUSTOMREQUEST, method);
+    curl_easy_setopt(h, CURLOPT_WRITEFUNCTION, collect);
+    curl_easy_setopt(h, CURLOPT_WRITEDATA, &r->body);
+    curl_easy_setopt(h, CURLOPT_HEADERFUNCTION, header_line);
+    curl_easy_setopt(h, CURLOPT_HEADERDATA, r);
+    curl_easy_setopt(h, CURLOPT_ERRORBUFFER, c->error);
+    curl_easy_setopt(h, CURLOPT_CONNECTTIMEOUT, 10L);
+    curl_easy_setopt(h, CURLOPT_TIMEOUT, 120L);
+    curl_easy_setopt(h, CURLOPT_NOSIGNAL, 1L);
+    struct curl_slist *headers = NULL;
+    if (type) {
+        char line[128];
+        snprintf(line, sizeof line, "Content-Type: %s", type);
+        headers = curl_slist_append(headers, line);
+        headers = curl_slist_append(headers, "Expect:");
+        curl_easy_setopt(h, CURLOPT_POSTFIELDS, body);
+        curl_easy_setopt(h, CURLOPT_POSTFIELDSIZE_LARGE, (curl_off_t)len);
+    }
+    headers = curl_slist_append(headers, "Accept: application/json, text/plain");
+    curl_easy_setopt(h, CURLOPT_HTTPHEADER, headers);
+    c->error[0] = '\0';
+    CURLcode rc = curl_easy_perform(h);
+    curl_slist_free_all(headers);
+    if (rc != CURLE_OK) {
+        fprintf(stderr, "%stightknot remote: cannot reach %s: %s\n", c->tty ? "\n" : "", c->base,
+                c->error[0] ? c->error : curl_easy_strerror(rc));
+        return false;
+    }
+    curl_easy_getinfo(h, CURLINFO_RESPONSE_CODE, &r->status);
+    if (!r->body.data)
+        collect("", 1, 0, &r->body);
+    return true;
+}
+
+/* The problem detail of an error response (or its start). */
+static void problem_text(const response *r, char *out, size_t size)
+{
+    json_t *doc = r->body.data ? json_loads(r->body.data, 0, NULL) : NULL;
+    const char *detail = json_string_value(json_object_get(doc, "detail"));
+    if (detail)
+        snprintf(out, size, "%s", detail);
+    else
+        snprintf(out, size, "HTTP %ld: %.200s", r->status, r->body.data ? r->body.data : "");
+    json_decref(doc);
+}
+
+/* ------------------------------------------------------------ files */
+
+/* dir/file into path; false when it does not fit. */
+static bool join_path(char *path, size_t size, const char *dir, const char *file)
+{
+    int n = snprintf(path, size, "%s/%s", dir, file);
+    return n >= 0 && (size_t)n < size;
+}
+
+static bool write_file(const char *path, const char *data, size_t len)
+{
+    char tmp[4200];
+    snprintf(tmp, sizeof tmp, "%s.part", path);
+    FILE *f = fopen(tmp, "wb");
+    bool ok = f && fwrite(data, 1, len, f) == len;
+    if (f && fclose(f) != 0)
+        ok = false;
+    if (ok && rename(tmp, path) != 0)
+        ok = false;
+    if (!ok) {
+        fprintf(stderr, "tightknot remote: cannot write %s: %s\n", path, strerror(errno));
+        unlink(tmp);
+    }
+    return ok;
+}
+
+static char *read_file(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    buffer b = {0};
+    char chunk[65536];
+    size_t n;
+    while ((n = fread(chunk, 1, sizeof chunk, f)) > 0)
+        if (collect(chunk, 1, n, &b) != n) {
+            free(b.data);
+            fclose(f);
+            return NULL;
+        }
+    bool bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(b.data);
+        return NULL;
+    }
+    if (!b.data)
+        collect("", 1, 0, &b);
+    *len = b.len;
+    return b.data;
+}
+
+/* ------------------------------------------------------------ jobs */
+
+typedef enum { ITEM_WAITING, ITEM_RUNNING, ITEM_FINISHED } item_phase;
+
+typedef struct item {
+    char *path;
+    char *name;          /* file name without .vect: the job's name */
+    long long job;       /* 0 until submitted */
+    item_phase phase;
+    char state[16];      /* the job's state when finished */
+    double ropelength, thickness, residual, seconds;
+    long long components, vertices, struts, steps;
+    char *row;           /* summary row, once finished */
+    char message[256];
+} item;
+
+static int by_name(const void *a, const void *b)
+{
+    return strcmp(((const item *)a)->name, ((const item *)b)->name);
+}
+
+static char *base_name(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    const char *start = slash ? slash + 1 : path;
+    size_t n = strlen(start);
+    if (n > 5 && strcmp(start + n - 5, ".vect") == 0)
+        n -= 5;
+    return strndup(start, n);
+}
+
+static bool add_item(item **items, size_t *n, size_t *cap, const char *path)
+{
+    if (*n == *cap) {
+        *cap = *cap ? 2 * *cap : 64;
+        item *grown = realloc(*items, *cap * sizeof *grown);
+        if (!grown)
+            return false;
+        *items = grown;
+    }
+    item *it = &(*items)[*n];
+    memset(it, 0, sizeof *it);
+    it->path = strdup(path);
+    it->name = base_name(path);
+    it->ropelength = it->thickness = it->residual = it->seconds = NAN;
+    if (!it->path || !it->name)
+        return false;
+    (*n)++;
+    return true;
+}
+
+/* The files named on the command line, a directory standing for its
+ * *.vect files; sorted by name.  False (message printed) on a bad one. */
+static bool gather(int argc, char **argv, item **items, size_t *n)
+{
+    size_t cap = 0;
+    *items = NULL;
+    *n = 0;
+    for (int i = 0; i < argc; i++) {
+        struct stat st;
+        if (stat(argv[i], &st) != 0) {
+            fprintf(stderr, "tightknot remote: %s: %s\n", argv[i], strerror(errno));
+            return false;
+        }
+        if (!S_ISDIR(st.st_mode)) {
+            if (!add_item(items, n, &cap, argv[i]))
+                return false;
+            continue;
+        }
+        DIR *d = opendir(argv[i]);
+        if (!d) {
+            fprintf(stderr, "tightknot remote: %s: %s\n", argv[i], strerror(errno));
+            return false;
+        }
+        struct dirent *e;
+        while ((e = readdir(d)) != NULL) {
+            size_t len = strlen(e->d_name);
+            if (len <= 5 || strcmp(e->d_name + len - 5, ".vect") || e->d_name[0] == '.')
+                continue;
+            char path[4096];
+            snprintf(path, sizeof path, "%s/%s", argv[i], e->d_name);
+            if (!add_item(items, n, &cap, path)) {
+                closedir(d);
+                return false;
+            }
+        }
+        closedir(d);
+    }
+    qsort(*items, *n, sizeof **items, by_name);
+    for (size_t i = 1; i < *n; i++)
+        if (!strcmp((*items)[i].name, (*items)[i - 1].name)) {
+            fprintf(stderr, "tightknot remote: two files are called %s (%s and %s); their "
+                            "results would overwrite each other\n",
+                    (*items)[i].name, (*items)[i - 1].path, (*items)[i].path);
+            return false;
+        }
+    return true;
+}
+
+static item *find_item(item *items, size_t n, const char *name)
+{
+    item key;
+    key.name = (char *)name;
+    return bsearch(&key, items, n, sizeof key, by_name);
+}
+
+static const char summary_header[] =
+    "name\tcomponents\tvertices\tropelength\tthickness\tresidual\tstruts\tsteps\tseconds\tstate\n";
+
+/* Reads an earlier summary: rows of files that are done are kept. */
+static void load_summary(const char *out, item *items, size_t n)
+{
+    char path[4096];
+    if (!join_path(path, sizeof path, out, "summary.tsv"))
+        return;
+    size_t len = 0;
+    char *text = read_file(path, &len);
+    if (!text)
+        return;
+    char *save = NULL;
+    for (char *line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+        const char *tab = strchr(line, '\t');
+        const char *state = strrchr(line, '\t');
+        if (!tab || !state || strncmp(line, "name\t", 5) == 0)
+            continue;
+        char name[1024];
+        snprintf(name, sizeof name, "%.*s", (int)(tab - line), line);
+        item *it = find_item(items, n, name);
+        if (it && !strcmp(state + 1, "done")) {
+            size_t rowlen = strlen(line) + 2;
+            it->row = malloc(rowlen);
+            if (it->row)
+                snprintf(it->row, rowlen, "%s\n", line);
+            it->phase = ITEM_FINISHED;
+            snprintf(it->state, sizeof it->state, "done");
+        }
+    }
+    free(text);
+}
+
+/* Reads the job ids of earlier submissions (name TAB id per line). */
+static void load_jobs(const char *out, item *items, size_t n)
+{
+    char path[4096];
+    if (!join_path(path, sizeof path, out, "jobs.tsv"))
+        return;
+    size_t len = 0;
+    char *text = read_file(path, &len);
+    if (!text)
+        return;
+    char *save = NULL;
+    for (char *line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+        char *tab = strchr(line, '\t');
+        if (!tab)
+            continue;
+        *tab = '\0';
+        item *it = find_item(items, n, line);
+        if (it && it->phase == ITEM_WAITING)
+            it->job = strtoll(tab + 1, NULL, 10);
+    }
+    free(text);
+}
+
+static bool append_job(const char *out, const item *it)
+{
+    char path[4096];
+    if (!join_path(path, sizeof path, out, "jobs.tsv"))
+        return false;
+    FILE *f = fopen(path, "a");
+    bool ok = f && fprintf(f, "%s\t%lld\n", it->name, it->job) > 0;
+    if (f && fclose(f) != 0)
+        ok = false;
+    if (!ok)
+        fprintf(stderr, "tightknot remote: cannot write %s: %s\n", path, strerror(errno));
+    return ok;
+}
+
+/* Rewrites summary.tsv with every finished file, in name order. */
+static bool save_summary(const char *out, const item *items, size_t n)
+{
+    buffer b = {0};
+    collect((char *)summary_header, 1, strlen(summary_header), &b);
+    for (size_t i = 0; i < n; i++)
+        if (items[i].row)
+            collect(items[i].row, 1, strlen(items[i].row), &b);
+    char path[4096];
+    if (!join_path(path, sizeof path, out, "summary.tsv"))
+        return false;
+    bool ok = b.data && write_file(path, b.data, b.len);
+    free(b.data);
+    return ok;
+}
+
+static double number_or_nan(const json_t *o, const char *key)
+{
+    const json_t *v = json_object_get(o, key);
+    return json_is_number(v) ? json_number_value(v) : NAN;
+}
+
+static void format_number(char *out, size_t size, double x)
+{
+    if (isfinite(x))
+        snprintf(out, size, "%.17g", x);
+    else
+        snprintf(out, size, "-");
+}
+
+/* Downloads a finished job's curve and struts; false on failure. */
+static bool download(client *c, long long job, const char *out, const char *name)
+{
+    char path[4200], api[128];
+    response r = {0};
+    snprintf(api, sizeof api, "/v1/jobs/%lld/vect", job);
+    curl_easy_reset(c->curl);
+    bool ok = request(c, "GET", api, NULL, NULL, 0, &r) && r.status == 200;
+    /* the API answers JSON when asked for it first; here the text */
+    if (ok) {
+        json_t *doc = json_loadb(r.body.data, r.body.len, 0, NULL);
+        const char *vect = json_string_value(json_object_get(doc, "vect"));
+        snprintf(path, sizeof path, "%s/%s.vect", out, name);
+        ok = vect ? write_file(path, vect, strlen(vect)) : write_file(path, r.body.data, r.body.len);
+        json_decref(doc);
+    }
+    snprintf(api, sizeof api, "/v1/jobs/%lld/struts", job);
+    if (ok)
+        ok = request(c, "GET", api, NULL, NULL, 0, &r) && r.status == 200;
+    if (ok) {
+        snprintf(path, sizeof path, "%s/%s.struts.json", out, name);
+        ok = write_file(path, r.body.data, r.body.len);
+    }
+    free(r.body.data);
+    return ok;
+}
+
+/* Fills a finished item from its job record. */
+static void finish_item(item *it, const json_t *job)
+{
+    it->phase = ITEM_FINISHED;
+    const char *state = json_string_value(json_object_get(job, "state"));
+    snprintf(it->state, sizeof it->state, "%s", state ? state : "failed");
+    it->ropelength = number_or_nan(job, "ropelength");
+    it->thickness = number_or_nan(job, "thickness");
+    it->residual = number_or_nan(job, "residual");
+    it->seconds = number_or_nan(job, "seconds");
+    it->components = (long long)json_integer_value(json_object_get(job, "components"));
+    it->vertices = (long long)json_integer_value(json_object_get(job, "vertices"));
+    it->struts = (long long)json_integer_value(json_object_get(job, "struts"));
+    it->steps = (long long)json_integer_value(
+        json_object_get(json_object_get(job, "progress"), "step"));
+    const char *error = json_string_value(json_object_get(job, "error"));
+    if (error)
+        snprintf(it->message, sizeof it->message, "%s", error);
+}
+
+static void make_row(item *it)
+{
+    char rope[32], thick[32], resid[32], secs[32];
+    format_number(rope, sizeof rope, it->ropelength);
+    format_number(thick, sizeof thick, it->thickness);
+    format_number(resid, sizeof resid, it->residual);
+    format_number(secs, sizeof secs, it->seconds);
+    size_t n = strlen(it->name) + 256;
+    free(it->row);
+    it->row = malloc(n);
+    if (it->row)
+        snprintf(it->row, n, "%s\t%lld\t%lld\t%s\t%s\t%s\t%lld\t%lld\t%s\t%s\n", it->name,
+                 it->components, it->vertices, rope, thick, resid, it->struts, it->steps, secs,
+                 it->state);
+}
+
+/* Submits one file; returns REMOTE_OK, REMOTE_FAILED (the server refused the file:
+ * the item is finished as failed), REMOTE_SERVER, or -1 for a full queue. */
+static int submit_one(client *c, item *it, const char *query, double *retry)
+{
+    size_t len = 0;
+    char *text = read_file(it->path, &len);
+    if (!text) {
+        it->phase = ITEM_FINISHED;
+        snprintf(it->state, sizeof it->state, "failed");
+        snprintf(it->message, sizeof it->message, "cannot read %s: %s", it->path,
+                 strerror(errno));
+        return REMOTE_FAILED;
+    }
+    char *escaped = curl_easy_escape(c->curl, it->name, 0);
+    char path[4096];
+    snprintf(path, sizeof path, "/v1/jobs?name=%s%s", escaped ? escaped : "job", query);
+    curl_free(escaped);
+    response r = {0};
+    bool reached = request(c, "POST", path, "text/plain", text, len, &r);
+    free(text);
+    int status = REMOTE_OK;
+    if (!reached) {
+        status = REMOTE_SERVER;
+    } else if (r.status == 202) {
+        json_t *job = json_loadb(r.body.data, r.body.len, 0, NULL);
+        it->job = (long long)json_integer_value(json_object_get(job, "id"));
+        it->phase = ITEM_RUNNING;
+        json_decref(job);
+        if (it->job <= 0) {
+            fprintf(stderr, "tightknot remote: the server's answer has no job id\n");
+            status = REMOTE_SERVER;
+        }
+    } else if (r.status == 429 || r.status == 503) {
+        *retry = r.retry_after > 0 ? r.retry_after : 5.0;
+        status = -1;
+    } else if (r.status >= 400 && r.status < 500) {
+        it->phase = ITEM_FINISHED;
+        snprintf(it->state, sizeof it->state, "refused");
+        problem_text(&r, it->message, sizeof it->message);
+        status = REMOTE_FAILED;
+    } else {
+        char detail[256];
+        problem_text(&r, detail, sizeof detail);
+        fprintf(stderr, "tightknot remote: submitting %s: %s\n", it->name, detail);
+        status = REMOTE_SERVER;
+    }
+    free(r.body.data);
+    return status;
+}
+
+/* The query string of the run options given on the command line. */
+typedef struct run_args {
+    char query[1024];
+    char out[4096];
+    long parallel;
+    double poll;
+} run_args;
+
+static void progress_line(client *c, const item *items, size_t n, const char *last)
+{
+    if (!c->tty)
+        return;
+    size_t done = 0, running = 0, failed = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (items[i].phase == ITEM_RUNNING)
+            running++;
+        else if (items[i].phase == ITEM_FINISHED) {
+            done++;
+            if (strcmp(items[i].state, "done"))
+                failed++;
+        }
+    }
+    int width = 30;
+    int filled = n ? (int)((double)width * (double)done / (double)n) : width;
+    char bar[64];
+    for (int i = 0; i < width; i++)
+        bar[i] = i < filled ? '=' : ' ';
+    bar[width] = '\0';
+    fprintf(stderr, "\r[%s] %zu/%zu finished, %zu running, %zu failed  %-40.40s", bar, done, n,
+            running, failed, last ? last : "");
+    fflush(stderr);
+}
+
+static void report_item(client *c, const item *it)
+{
+    if (c->tty)
+        fputc('\n', stderr);
+    if (!strcmp(it->state, "done"))
+        fprintf(stderr, "%s: done, ropelength %.6f, %lld steps, %.1f s\n", it->name,
+                it->ropelength, it->steps, it->seconds);
+    else
+        fprintf(stderr, "%s: %s%s%s\n", it->name, it->state, it->message[0] ? ": " : "",
+                it->message);
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void pause_for(double seconds)
+{
+    struct timespec ts = {(time_t)seconds, (long)((seconds - floor(seconds)) * 1e9)};
+    nanosleep(&ts, NULL);
+}
+
+static int cmd_submit(client *c, const run_args *a, int argc, char **argv)
+{
+    item *items = NULL;
+    size_t n = 0;
+    if (argc == 0) {
+        fprintf(stderr, "tightknot remote submit: no FILES given\nTry 'tightknot remote --help'.\n");
+        return REMOTE_USAGE;
+    }
+    if (!gather(argc, argv, &items, &n))
+        return REMOTE_USAGE;
+    if (n == 0) {
+        fprintf(stderr, "tightknot remote submit: no .vect files found\n");
+        free(items);
+        return REMOTE_USAGE;
+    }
+    if (mkdir(a->out, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "tightknot remote: cannot make %s: %s\n", a->out, strerror(errno));
+        return REMOTE_FAILED;
+    }
+    load_summary(a->out, items, n);
+    load_jobs(a->out, items, n);
+    /* jobs submitted by an earlier run are followed, not submitted again */
+    size_t running = 0;
+    for (size_t i = 0; i < n; i++)
+        if (items[i].phase == ITEM_WAITING && items[i].job > 0) {
+            items[i].phase = ITEM_RUNNING;
+            running++;
+        }
+    int status = REMOTE_OK;
+    size_t next = 0;
+    double wait_until = 0.0;
+    bool unreachable = false;
+    for (;;) {
+        /* submit while there is room */
+        while (!unreachable && running < (size_t)a->parallel && now_seconds() >= wait_until) {
+            while (next < n && items[next].phase != ITEM_WAITING)
+                next++;
+            if (next == n)
+                break;
+            item *it = &items[next];
+            double retry = 0.0;
+            int rc = submit_one(c, it, a->query, &retry);
+            if (rc == -1) {
+                wait_until = now_seconds() + retry;
+                break;
+            }
+            if (rc == REMOTE_SERVER) {
+                unreachable = true;
+                break;
+            }
+            if (rc == REMOTE_FAILED) {
+                report_item(c, it);
+                status = REMOTE_FAILED;
+                make_row(it);
+                save_summary(a->out, items, n);
+                continue;
+            }
+            if (!append_job(a->out, it))
+                status = REMOTE_FAILED;
+            running++;
+        }
+        if (unreachable || (running == 0 && next >= n))
+            break;
+        /* follow the running jobs */
+        const char *last = NULL;
+        for (size_t i = 0; i < n && !unreachable; i++) {
+            item *it = &items[i];
+            if (it->phase != ITEM_RUNNING)
+                continue;
+            char path[64];
+            snprintf(path, sizeof path, "/v1/jobs/%lld", it->job);
+            response r = {0};
+            if (!request(c, "GET", path, NULL, NULL, 0, &r)) {
+                unreachable = true;
+                free(r.body.data);
+                break;
+            }
+            json_t *job = r.status == 200 ? json_loadb(r.body.data, r.body.len, 0, NULL) : NULL;
+            const char *state = json_string_value(json_object_get(job, "state"));
+            if (r.status == 404) {
+                /* the server lost it (a new store): submit it again */
+                it->phase = ITEM_WAITING;
+                it->job = 0;
+                running--;
+                if (next > i)
+                    next = i;
+            } else if (!state) {
+                char detail[256];
+                problem_text(&r, detail, sizeof detail);
+                fprintf(stderr, "tightknot remote: job %lld: %s\n", it->job, detail);
+                unreachable = true;
+            } else if (!strcmp(state, "done") || !strcmp(state, "failed") ||
+                       !strcmp(state, "cancelled")) {
+                finish_item(it, job);
+                running--;
+                if (!strcmp(state, "done") && !download(c, it->job, a->out, it->name)) {
+                    snprintf(it->state, sizeof it->state, "failed");
+                    snprintf(it->message, sizeof it->message, "downloading the result failed");
+                }
+                if (strcmp(it->state, "done"))
+                    status = REMOTE_FAILED;
+                make_row(it);
+                if (!save_summary(a->out, items, n))
+                    status = REMOTE_FAILED;
+                report_item(c, it);
+            } else {
+                last = it->name;
+            }
+            json_decref(job);
+            free(r.body.data);
+        }
+        progress_line(c, items, n, last);
+        if (unreachable)
+            break;
+        if (running > 0 || wait_until > now_seconds())
+            pause_for(a->poll);
+    }
+    if (c->tty)
+        fputc('\n', stderr);
+    size_t done = 0, finished = 0;
+    for (size_t i = 0; i < n; i++)
+        if (items[i].phase == ITEM_FINISHED) {
+            finished++;
+            done += !strcmp(items[i].state, "done");
+        }
+    save_summary(a->out, items, n);
+    fprintf(stderr, "%zu of %zu files done, %zu failed; summary in %s/summary.tsv\n", done, n,
+            finished - done, a->out);
+    if (unreachable) {
+        fprintf(stderr, "tightknot remote: stopped; run the same command again to resume\n");
+        status = REMOTE_SERVER;
+    }
+    for (size_t i = 0; i < n; i++) {
+        free(items[i].path);
+        free(items[i].name);
+        free(items[i].row);
+    }
+    free(items);
+    return status;
+}
+
+static bool parse_job_id(const char *text, long long *id)
+{
+    char *end = NULL;
+    errno = 0;
+    *id = strtoll(text, &end, 10);
+    if (errno || end == text || *end || *id <= 0) {
+        fprintf(stderr, "tightknot remote: '%s' is not a job id (a positive whole number)\n",
+                text);
+        return false;
+    }
+    return true;
+}
+
+static int cmd_jobs(client *c, const char *what, const run_args *a, bool json, int argc,
+                    char **argv)
+{
+    if (argc == 0) {
+        fprintf(stderr, "tightknot remote %s: no JOB given\nTry 'tightknot remote --help'.\n",
+                what);
+        return REMOTE_USAGE;
+    }
+    int status = REMOTE_OK;
+    if (!strcmp(what, "fetch") && mkdir(a->out, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "tightknot remote: cannot make %s: %s\n", a->out, strerror(errno));
+        return REMOTE_FAILED;
+    }
+    for (int i = 0; i < argc; i++) {
+        long long id;
+        if (!parse_job_id(argv[i], &id))
+            return REMOTE_USAGE;
+        char path[64];
+        snprintf(path, sizeof path, "/v1/jobs/%lld", id);
+        response r = {0};
+        bool cancel = !strcmp(what, "cancel");
+        if (!request(c, cancel ? "DELETE" : "GET", path, NULL, NULL, 0, &r))
+            return REMOTE_SERVER;
+        if (r.status >= 400) {
+            char detail[256];
+            problem_text(&r, detail, sizeof detail);
+            fprintf(stderr, "tightknot remote: job %lld: %s\n", id, detail);
+            status = r.status == 404 || r.status == 409 ? REMOTE_FAILED : REMOTE_SERVER;
+            free(r.body.data);
+            continue;
+        }
+        json_t *job = json_loadb(r.body.data, r.body.len, 0, NULL);
+        const char *name = json_string_value(json_object_get(job, "name"));
+        const char *state = json_string_value(json_object_get(job, "state"));
+        if (json && !cancel) {
+            printf("%s\n", r.body.data);
+        } else if (!strcmp(what, "fetch")) {
+            char file[64];
+            snprintf(file, sizeof file, "job-%lld", id);
+            if (!download(c, id, a->out, file))
+                status = REMOTE_FAILED;
+            else
+                printf("job %lld (%s): %s/%s.vect, %s/%s.struts.json\n", id, name ? name : "",
+                       a->out, file, a->out, file);
+        } else {
+            char rope[32], resid[32];
+            format_number(rope, sizeof rope, number_or_nan(job, "ropelength"));
+            format_number(resid, sizeof resid, number_or_nan(job, "residual"));
+            const char *error = json_string_value(json_object_get(job, "error"));
+            printf("%lld\t%s\t%s\tstep %lld\tropelength %s\tresidual %s%s%s\n", id,
+                   name ? name : "", cancel ? (r.status == 202 ? "cancelling" : "cancelled")
+                                            : (state ? state : "?"),
+                   (long long)json_integer_value(
+                       json_object_get(json_object_get(job, "progress"), "step")),
+                   rope, resid, error ? "\terror " : "", error ? error : "");
+        }
+        json_decref(job);
+        free(r.body.data);
+    }
+    return status;
+}
+
+int tk_remote_main(int argc, char **argv)
+{
+    const char *server = getenv("TIGHTKNOT_SERVER");
+    if (!server || !*server)
+        server = "http://127.0.0.1:8080";
+    run_args a;
+    memset(&a, 0, sizeof a);
+    snprintf(a.out, sizeof a.out, "tightknot-results");
+    a.parallel = 4;
+    a.poll = 1.0;
+    bool json = false;
+    tk_job_options opts = TK_JOB_OPTIONS_INIT;
+    const char *command = NULL;
+    char **rest = calloc((size_t)argc + 1, sizeof *rest);
+    int nrest = 0;
+    if (!rest)
+        return REMOTE_FAILED;
+    int status = REMOTE_OK;
+    for (int i = 0; i < argc && status == REMOTE_OK; i++) {
+        const char *arg = argv[i];
+        bool has_value = i + 1 < argc;
+        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
+            fputs(tk_remote_help, stdout);
+            free(rest);
+            return REMOTE_OK;
+        }
+        if (!strcmp(arg, "--")) {
+            while (++i < argc)
+                rest[nrest++] = argv[i];
+            break;
+        }
+        if (strncmp(arg, "--", 2) != 0) {
+            if (!command)
+                command = arg;
+            else
+                rest[nrest++] = argv[i];
+            continue;
+        }
+        const char *name = arg + 2;
+        if (!strcmp(name, "json")) {
+            json = true;
+        } else if (!strcmp(name, "autoscale")) {
+            opts.autoscale = true;
+        } else if (!has_value) {
+            fprintf(stderr, "tightknot remote: %s needs a value\n", arg);
+            status = REMOTE_USAGE;
+        } else if (!strcmp(name, "server")) {
+            server = argv[++i];
+        } else if (!strcmp(name, "out")) {
+            snprintf(a.out, sizeof a.out, "%s", argv[++i]);
+        } else if (!strcmp(name, "parallel") || !strcmp(name, "poll")) {
+            char *end = NULL;
+            double x = strtod(argv[++i], &end);
+            bool parallel = !strcmp(name, "parallel");
+            if (end == argv[i] || *end || !(x > 0) || (parallel && (x != floor(x) || x > 1000)) ||
+                x > 3600) {
+                fprintf(stderr, "tightknot remote: %s: '%s' must be %s\n", arg, argv[i],
+                        parallel ? "a whole number from 1 to 1000" : "positive seconds");
+                status = REMOTE_USAGE;
+            } else if (parallel) {
+                a.parallel = (long)x;
+            } else {
+                a.poll = x;
+            }
+        } else if (tk_job_option_known(name)) {
+            tk_error err;
+            if (tk_job_option_set_text(&opts, name, argv[++i], &err) != TK_OK) {
+                fprintf(stderr, "tightknot remote: %s\n", err.message);
+                status = REMOTE_USAGE;
+            }
+        } else {
+            fprintf(stderr, "tightknot remote: unknown option '%s'\n", arg);
+            status = REMOTE_USAGE;
+        }
+    }
+    if (status == REMOTE_OK && !command) {
+        fprintf(stderr, "tightknot remote: no COMMAND given (submit, status, cancel or fetch)\n");
+        status = REMOTE_USAGE;
+    }
+    if (status != REMOTE_OK) {
+        fprintf(stderr, "Try 'tightknot remote --help'.\n");
+        free(rest);
+        return status;
+    }
+    /* the options as a query string, only those that differ from the
+     * defaults, so the server's defaults stay the server's */
+    tk_job_options defaults = TK_JOB_OPTIONS_INIT;
+    size_t q = 0;
+#define QUERY(cond, ...)                                                                      \
+    if (cond)                                                                                 \
+    q += (size_t)snprintf(a.query + q, sizeof a.query - q, __VA_ARGS__)
+    QUERY(opts.resolution != defaults.resolution, "&resolution=%.17g", opts.resolution);
+    QUERY(opts.steps != defaults.steps, "&steps=%ld", opts.steps);
+    QUERY(opts.time != defaults.time, "&time=%.17g", opts.time);
+    QUERY(opts.residual != defaults.residual, "&residual=%.17g", opts.residual);
+    QUERY(opts.radius != defaults.radius, "&radius=%.17g", opts.radius);
+    QUERY(opts.lambda != defaults.lambda, "&lambda=%.17g", opts.lambda);
+    QUERY(opts.autoscale, "&autoscale=true");
+    QUERY(opts.every != defaults.every, "&every=%ld", opts.every);
+#undef QUERY
+
+    client c;
+    memset(&c, 0, sizeof c);
+    size_t blen = strlen(server);
+    while (blen > 0 && server[blen - 1] == '/')
+        blen--;
+    if (strncmp(server, "http://", 7) && strncmp(server, "https://", 8)) {
+        fprintf(stderr, "tightknot remote: --server: '%s' is not an http:// or https:// URL\n",
+                server);
+        free(rest);
+        return REMOTE_USAGE;
+    }
+    snprintf(c.base, sizeof c.base, "%.*s", (int)blen, server);
+    c.tty = isatty(STDERR_FILENO) != 0;
+    if (curl_global_init(CURL_GLOBAL_DEFAULT) != CURLE_OK || !(c.curl = curl_easy_init())) {
+        fprintf(stderr, "tightknot remote: cannot start libcurl\n");
+        free(rest);
+        return REMOTE_FAILED;
+    }
+    if (!strcmp(command, "submit"))
+        status = cmd_submit(&c, &a, nrest, rest);
+    else if (!strcmp(command, "status") || !strcmp(command, "cancel") ||
+             !strcmp(command, "fetch"))
+        status = cmd_jobs(&c, command, &a, json, nrest, rest);
+    else {
+        fprintf(stderr, "tightknot remote: unknown command '%s' (submit, status, cancel or "
+                        "fetch)\nTry 'tightknot remote --help'.\n",
+                command);
+        status = REMOTE_USAGE;
+    }
+    curl_easy_cleanup(c.curl);
+    curl_global_cleanup();
+    free(rest);
+    return status;
+}
