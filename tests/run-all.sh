@@ -2,7 +2,7 @@
 # Runs every test and closes with one line: "tests: N passed, M failed".
 #   run-all.sh [--unit-only] BUILD_DIR SANITIZER_BUILD_DIR CATALOGUE_DIR
 # Unit tests (Check, one process per test) run from both build directories;
-# the command-line tests (tests/cli-*.sh) run against BUILD_DIR's programs.
+# the command-line, service and page tests run against BUILD_DIR's programs.
 set -u
 unit_only=0
 if [ "${1:-}" = "--unit-only" ]; then unit_only=1; shift; fi
@@ -51,10 +51,14 @@ for dir in "$build" $asan; do
     done
 done
 
+# The command-line tests (tests/cli-*.sh) and the suites in directories
+# (tests/*/run.sh: the service's API, the page in a browser) all end with
+# "NAME: N passed, M failed".
 if [ "$unit_only" -eq 0 ]; then
-    for t in tests/cli-*.sh; do
+    for t in tests/cli-*.sh tests/*/run.sh; do
         [ -f "$t" ] || continue
-        TK_BUILD=$build sh "$t" >"$log" 2>&1
+        TK_BUILD=$build TK_DAEMON=$build/tightknotd TK_CLI=$build/tightknot TK_WEB=$build/web \
+            sh "$t" >"$log" 2>&1
         line=$(grep -E '^[a-z-]+: [0-9]+ passed, [0-9]+ failed' "$log" | tail -n 1)
         if [ -z "$line" ]; then
             failed=$((failed + 1)); echo "FAIL $t: no summary"; tail -n 20 "$log"; continue
@@ -63,7 +67,7 @@ if [ "$unit_only" -eq 0 ]; then
         f=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\2/')
         passed=$((passed + p)); failed=$((failed + f))
         echo "$t: $line"
-        [ "$f" -eq 0 ] || grep -E '^FAIL' "$log"
+        [ "$f" -eq 0 ] || grep -E '^FAIL|^not ok|^# fail|Error' "$log" | head -n 40
     done
 fi
 
