@@ -146,13 +146,16 @@ static mhd_result send_problem_ext(tk_api *a, struct MHD_Connection *c, unsigned
 
 #define send_problem(a, c, status, ...) send_problem_ext(a, c, status, NULL, NULL, __VA_ARGS__)
 
-/* A 422 for an engine or parser error: a VECT error names its line. */
+/* A 422 for an engine or parser error: a VECT error names its line, be it
+ * malformed (TK_EPARSE) or over a limit (TK_ELIMIT: too many components or
+ * vertices, a count too large), as the reader's messages start "line N:". */
 static mhd_result send_input_error(tk_api *a, struct MHD_Connection *c, const tk_error *err,
                                    const char *option)
 {
     json_t *extra = json_object();
     int line = 0;
-    if (err->code == TK_EPARSE && sscanf(err->message, "line %d", &line) == 1 && line > 0)
+    if ((err->code == TK_EPARSE || err->code == TK_ELIMIT) &&
+        sscanf(err->message, "line %d", &line) == 1 && line > 0)
         json_object_set_new(extra, "line", json_integer(line));
     if (option)
         json_object_set_new(extra, "option", json_string(option));
@@ -696,8 +699,9 @@ static mhd_result post_job(tk_api *a, struct MHD_Connection *c, const request *r
     tk_job_options opts = TK_JOB_OPTIONS_INIT;
     query_scan q = {&opts, "untitled", {0, ""}, "", 0};
     MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, scan_query, &q);
+    /* an unknown query parameter is an unknown option, named as in JSON */
     if (q.rc)
-        return send_input_error(a, c, &q.err, tk_job_option_known(q.bad) ? q.bad : NULL);
+        return send_input_error(a, c, &q.err, q.bad);
     if (!valid_name(q.name))
         return send_problem_ext(a, c, 422, json_pack("{s:s}", "field", "name"), NULL,
                                 "'name' must be under %d bytes", TK_JOB_NAME_SIZE);
