@@ -29,6 +29,7 @@
 #include "tk/curve.h"
 #include "tk/error.h"
 #include "tk/generate.h"
+#include "tk/jobspec.h"
 #include "tk/jsonmap.h"
 #include "tk/struts.h"
 #include "tk/thickness.h"
@@ -269,8 +270,8 @@ typedef struct cli_args {
     bool json;
     double tolerance;
     size_t vertices; /* 0: the generator's default */
-    tk_options run;  /* tighten's run options */
-    bool steps_given;
+    tk_job_options job; /* tighten's run options */
+    double overstep;    /* 0: the engine's default */
     const char *output, *struts_out, *log_out, *snapshots;
     size_t every;
     int npos;        /* the arguments that are not options, in order */
@@ -358,53 +359,40 @@ static int apply_option(const char *cmd, unsigned flag, const char *value, cli_a
     case OPT_RESOLUTION:
     case OPT_TIME:
     case OPT_RESIDUAL:
+    case OPT_STEPS: {
+        /* the run options shared with the service: one set of names,
+         * domains and messages (tk/jobspec.h) */
+        const char *name = flag == OPT_RADIUS       ? "radius"
+                           : flag == OPT_LAMBDA     ? "lambda"
+                           : flag == OPT_RESOLUTION ? "resolution"
+                           : flag == OPT_TIME       ? "time"
+                           : flag == OPT_STEPS      ? "steps"
+                                                    : "residual";
+        tk_error err;
+        if (tk_job_option_set_text(&a->job, name, value, &err) != TK_OK) {
+            /* "option 'steps': ..." reads "--steps: ..." on a command line */
+            const char *why = strstr(err.message, "': ");
+            return usage_error(cmd, "--%s: %s", name, why ? why + 3 : err.message);
+        }
+        return EXIT_OK;
+    }
     case OPT_OVERSTEP: {
         double x = 0.0;
-        const char *name = flag == OPT_RADIUS       ? "--radius"
-                           : flag == OPT_LAMBDA     ? "--lambda"
-                           : flag == OPT_RESOLUTION ? "--resolution"
-                           : flag == OPT_TIME       ? "--time"
-                           : flag == OPT_OVERSTEP   ? "--overstep"
-                                                    : "--residual";
-        if (parse_real(cmd, name, value, &x))
+        if (parse_real(cmd, "--overstep", value, &x))
             return EXIT_USAGE;
-        bool positive_needed = flag == OPT_RADIUS || flag == OPT_LAMBDA;
-        if (positive_needed ? !(x > 0.0) : x < 0.0)
-            return usage_error(cmd, "%s: '%s' must be %s", name, value,
-                               positive_needed ? "positive" : "zero or more");
-        if (flag == OPT_RADIUS)
-            a->run.radius = x;
-        else if (flag == OPT_LAMBDA)
-            a->run.lambda = x;
-        else if (flag == OPT_RESOLUTION)
-            a->run.resolution = x;
-        else if (flag == OPT_TIME)
-            a->run.max_seconds = x;
-        else if (flag == OPT_OVERSTEP) {
-            if (!(x > 0.0 && x < 0.1))
-                return usage_error(cmd, "--overstep: '%s' must be in (0, 0.1)", value);
-            a->run.overstep_tolerance = x;
-            a->run.correction_tolerance = 0.1 * x;
-        }
-        else
-            a->run.min_residual = x;
+        if (!(x > 0.0 && x < 0.1))
+            return usage_error(cmd, "--overstep: '%s' must be in (0, 0.1)", value);
+        a->overstep = x;
         return EXIT_OK;
     }
     case OPT_AUTOSCALE:
-        a->run.autoscale = true;
+        a->job.autoscale = true;
         return EXIT_OK;
-    case OPT_STEPS:
     case OPT_EVERY: {
         long long n = 0;
-        if (parse_integer(cmd, flag == OPT_STEPS ? "--steps" : "--every", value, 1, LONG_MAX,
-                          &n))
+        if (parse_integer(cmd, "--every", value, 1, LONG_MAX, &n))
             return EXIT_USAGE;
-        if (flag == OPT_STEPS) {
-            a->run.max_steps = (long)n;
-            a->steps_given = true;
-        } else {
-            a->every = (size_t)n;
-        }
+        a->every = (size_t)n;
         return EXIT_OK;
     }
     case OPT_OUTPUT:
@@ -435,9 +423,9 @@ static int parse_args(const char *cmd, int argc, char **argv, unsigned allowed,
     a->json = false;
     a->tolerance = DEFAULT_TOLERANCE;
     a->vertices = 0;
-    tk_options defaults = TK_OPTIONS_INIT;
-    a->run = defaults;
-    a->steps_given = false;
+    tk_job_options defaults = TK_JOB_OPTIONS_INIT;
+    a->job = defaults;
+    a->overstep = 0.0;
     a->output = a->struts_out = a->log_out = a->snapshots = NULL;
     a->every = 100;
     a->npos = 0;
@@ -860,8 +848,13 @@ static int cmd_tighten(int argc, char **argv)
     }
     if (a.npos != 1)
         return usage_error("tighten", a.npos == 0 ? "no FILE given" : "one FILE only");
-    if (!a.steps_given && a.run.max_seconds == 0.0 && a.run.min_residual == 0.0)
-        a.run.max_steps = 1000;
+    tk_options run_opts;
+    tk_job_options_to_run(&a.job, &run_opts);
+    run_opts.snapshot_every = 0; /* the snapshots are files, written here */
+    if (a.overstep > 0.0) {
+        run_opts.overstep_tolerance = a.overstep;
+        run_opts.correction_tolerance = 0.1 * a.overstep;
+    }
     const char *name = a.pos[0];
     tk_error err;
     tk_error_clear(&err);
@@ -889,7 +882,7 @@ static int cmd_tighten(int argc, char **argv)
     }
     tk_run *run = NULL;
     int status = EXIT_OK;
-    if (tk_run_new(c, &a.run, &run, &err) != TK_OK) {
+    if (tk_run_new(c, &run_opts, &run, &err) != TK_OK) {
         report(name, &err);
         status = EXIT_INPUT;
         goto done;

@@ -1,0 +1,89 @@
+#!/bin/sh
+# Command-line tests of `tightknot tighten`: the outputs agree with each
+# other (the --json figures, the output VECT measured again by `info`, the
+# per-step log, the snapshots, the struts file), and bad options and input
+# give the documented exit statuses with messages naming what is wrong.
+#   TK_BUILD=build TK_CATALOGUE=../shared/catalogue sh tests/cli-tighten.sh
+# Ends with "cli-tighten: N passed, M failed".
+set -u
+build=${TK_BUILD:-build}
+tk=$build/tightknot
+passed=0
+failed=0
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+trap 'exit 1' INT TERM
+
+check() { # check STATUS WHAT
+    if [ "$1" -eq 0 ]; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL $2"; fi
+}
+value() { # value NAME FILE: a number or string of a one-line JSON object
+    sed -n "s/.*\"$1\":\"*\([^,}\"]*\).*/\1/p" "$2" | head -n 1
+}
+close() { # close A B RELTOL: |A - B| <= RELTOL * |B|
+    awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; m = b < 0 ? -b : b;
+        exit !(a != "" && d <= t * m) }'
+}
+
+"$tk" generate torus 2 3 --vertices 90 >"$tmp/trefoil.vect"
+"$tk" tighten "$tmp/trefoil.vect" --autoscale --steps 40 --json -o "$tmp/out.vect" \
+    --struts "$tmp/struts.json" --log "$tmp/log.tsv" --snapshots "$tmp/snaps" --every 10 \
+    >"$tmp/result.json" 2>"$tmp/err"
+check $? "tighten exits 0: $(cat "$tmp/err")"
+[ "$(value steps "$tmp/result.json")" = 40 ]
+check $? "--json steps: $(cat "$tmp/result.json")"
+[ "$(value stop_reason "$tmp/result.json")" = steps ]
+check $? "stop_reason steps"
+rope=$(value ropelength "$tmp/result.json")
+"$tk" info "$tmp/out.vect" --json >"$tmp/info.json"
+check $? "info reads the output"
+close "$(value ropelength "$tmp/info.json")" "$rope" 1e-12
+check $? "info on the output gives $(value ropelength "$tmp/info.json"), tighten said $rope"
+close "$(value thickness "$tmp/info.json")" "$(value thickness "$tmp/result.json")" 1e-12
+check $? "thickness agrees"
+[ "$(value vertices "$tmp/info.json")" = "$(value vertices "$tmp/result.json")" ]
+check $? "vertex count agrees"
+# the log: a header, the start (step 0) and one line per step
+[ "$(wc -l <"$tmp/log.tsv")" -eq 42 ]
+check $? "log has $(wc -l <"$tmp/log.tsv") lines, want 42"
+last=$(tail -n 1 "$tmp/log.tsv" | cut -f 1,3)
+[ "$(echo "$last" | cut -f 1)" = 40 ]
+check $? "the log's last step is 40: $last"
+close "$(echo "$last" | cut -f 2)" "$rope" 1e-11
+check $? "the log's last ropelength $(echo "$last" | cut -f 2) is the result $rope"
+# ropelength only falls... or the log says why not: every thickness is at
+# least the diameter minus the overstep tolerance
+awk -F'\t' 'NR > 1 && $5 < 1 - 1.0001e-5 { bad = 1 } END { exit bad }' "$tmp/log.tsv"
+check $? "every logged thickness is within the overstep tolerance of the diameter"
+[ "$(ls "$tmp/snaps" | wc -l)" -eq 5 ]
+check $? "snapshots: $(ls "$tmp/snaps" | tr '\n' ' ') (want steps 0, 10, 20, 30, 40)"
+"$tk" info "$tmp/snaps/step-000040.vect" --json >"$tmp/snap.json"
+close "$(value ropelength "$tmp/snap.json")" "$rope" 1e-12
+check $? "the last snapshot is the final curve"
+n_struts=$(value struts "$tmp/result.json")
+[ "$(grep -o '"force"' "$tmp/struts.json" | wc -l)" -ge "$n_struts" ]
+check $? "struts file lists forces for $n_struts struts"
+
+# bad options: exit 1, named
+for args in "--radius 0" "--lambda -1" "--steps 2.5" "--resolution -1" "--time abc" \
+    "--residual nan" "--overstep 0.5" "--every 0" "--frobnicate 1"; do
+    # shellcheck disable=SC2086
+    "$tk" tighten "$tmp/trefoil.vect" $args >/dev/null 2>"$tmp/err"
+    status=$?
+    opt=$(echo "$args" | cut -d' ' -f1)
+    [ "$status" -eq 1 ] && grep -q -- "$opt" "$tmp/err"
+    check $? "tighten $args: exit $status, message $(head -n 1 "$tmp/err")"
+done
+# bad input: exit 2, the line named
+printf 'VECT\n1 3 0\n-3\n0\n0 0 0\n1 0 0\n0 q 0\n' >"$tmp/bad.vect"
+"$tk" tighten "$tmp/bad.vect" >/dev/null 2>"$tmp/err"
+[ $? -eq 2 ] && grep -q "bad.vect:7: expected coordinate y" "$tmp/err"
+check $? "a malformed file: $(cat "$tmp/err")"
+# a start thinner than the tube without --autoscale: exit 2, said why
+"$tk" generate torus 2 3 --vertices 90 >"$tmp/thin.vect"
+"$tk" tighten "$tmp/thin.vect" --radius 50 >/dev/null 2>"$tmp/err"
+[ $? -eq 2 ] && grep -qi "thick\|diameter" "$tmp/err"
+check $? "a start thinner than the tube: $(cat "$tmp/err")"
+
+echo "cli-tighten: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
