@@ -68,6 +68,7 @@ all: $(LIB) $(CLI) $(DAEMON)
 
 deps:
 	$(Q)./tools/install-deps.sh
+	$(Q)./tools/install-node-deps.sh
 
 $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)
