@@ -149,13 +149,18 @@ static double number_field(const json_t *o, const char *key)
     return json_is_number(v) ? json_number_value(v) : NAN;
 }
 
-/* Reads a stored history back (after a restart). */
-static void history_load(history *h, const char *text)
+/* Reads a stored history back (after a restart), the entries before step
+ * `resume` only: the stored text ends with the latest step, which the
+ * resumed run reports again as its start (and which is not on the stride,
+ * so it must not decide it). */
+static void history_load(history *h, const char *text, long resume)
 {
     json_t *a = text ? json_loads(text, 0, NULL) : NULL;
     size_t n = json_is_array(a) ? json_array_size(a) : 0;
     for (size_t i = 0; i < n && h->count < h->cap; i++) {
         const json_t *o = json_array_get(a, i);
+        if (!(number_field(o, "step") < (double)resume))
+            continue;
         tk_step_report r = {0};
         r.step = (long)number_field(o, "step");
         r.seconds = number_field(o, "seconds");
@@ -329,7 +334,7 @@ static int setup_run(tk_jobs *j, tk_job *job, job_run *jr, tk_error *err)
             opts.max_seconds = fmax(opts.max_seconds - jr->seconds_offset, 1e-3);
         char *hist = NULL;
         if (tk_store_text(j->store, job->id, TK_TEXT_HISTORY, &hist, NULL, NULL) == TK_OK)
-            history_load(&jr->hist, hist);
+            history_load(&jr->hist, hist, jr->step_offset);
         free(hist);
         jr->frames_before = job->frames;
     }
