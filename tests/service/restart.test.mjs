@@ -1,0 +1,138 @@
+// Jobs survive the daemon: after SIGKILL the store holds every job and the
+// unfinished ones run to the end at the next start; after SIGTERM (exit 0
+// within 10 s) the running job resumes where it stopped.
+
+import assert from 'node:assert/strict';
+import { describe, test } from 'node:test';
+
+import {
+    generate, sleep, startDaemon, submit, tempDir, tighten, waitFinal, waitJob,
+} from './lib.mjs';
+
+// The history of a resumed job: one run of increasing steps from 0 to the
+// job's step, crossing the step it was interrupted at.
+async function assertResumedHistory(d, job, interrupted) {
+    const h = (await d.get(`/v1/jobs/${job.id}/history`)).json;
+    assert.equal(h.step, job.progress.step);
+    assert.equal(h.steps[0].step, 0);
+    for (let i = 1; i < h.steps.length; i++)
+        assert.ok(h.steps[i].step > h.steps[i - 1].step, `history steps increase at ${i}: ${h.steps[i - 1].step}, ${h.steps[i].step}`);
+    assert.equal(h.steps.at(-1).step, job.progress.step);
+    assert.equal(h.steps.at(-1).ropelength, job.ropelength);
+    assert.ok(h.steps.some((s) => s.step <= interrupted) && h.steps.some((s) => s.step > interrupted),
+        'the history spans the interruption');
+    for (let i = 1; i < h.steps.length; i++)
+        assert.ok(h.steps[i].seconds >= h.steps[i - 1].seconds, `history seconds increase at ${i}`);
+}
+
+// Frames of a resumed job: the total the job reports, steps increasing.
+async function assertResumedFrames(d, job) {
+    const frames = [];
+    for (let offset = 0; ; offset += 200) {
+        const r = await d.get(`/v1/jobs/${job.id}/frames?offset=${offset}&limit=200`);
+        assert.equal(r.json.total, job.frames);
+        frames.push(...r.json.frames);
+        if (r.json.frames.length < 200) break;
+    }
+    assert.equal(frames.length, job.frames);
+    assert.ok(frames.length >= 2);
+    assert.equal(frames[0].step, 0);
+    for (let i = 1; i < frames.length; i++)
+        assert.ok(frames[i].step > frames[i - 1].step, `frame steps increase at ${i}: ${frames[i - 1].step}, ${frames[i].step}`);
+    for (const f of frames) assert.equal(f.coordinates.length, 3 * job.vertices);
+}
+
+describe('kill -9 and restart on the same store', () => {
+    test('all jobs listed; the interrupted one continues, the queued ones give the CLI results', async (t) => {
+        const dir = tempDir('kill');
+        const knot = await generate(dir, 'torus23.vect', ['torus', '2', '3', '--vertices', '40']);
+        const cli = tighten(dir, knot.path, 'torus23', ['--steps', '150']);
+
+        const d1 = await startDaemon({ workers: 1, dir });
+        t.after(() => d1.proc.kill('SIGKILL')); // when the test fails before the kill
+        // a 6-second job, then two short ones waiting behind it
+        const a = await submit(d1, { catalogue: '3.1', name: 'long', options: { resolution: 10, time: 6, every: 100 } });
+        const b = await submit(d1, knot.text, { query: 'steps=150&name=b' });
+        const c = await submit(d1, { vect: knot.text, name: 'c', options: { steps: 150 } });
+        await waitJob(d1, a.id, (j) => j.state === 'running' && j.progress.step > 0);
+        await sleep(3000); // the store is written every 2 s
+        const live = (await d1.get(`/v1/jobs/${a.id}`)).json;
+        assert.equal(live.state, 'running');
+        assert.equal((await d1.get(`/v1/jobs/${b.id}`)).json.state, 'queued');
+        await d1.kill();
+
+        const d2 = await startDaemon({ workers: 1, dir, db: d1.db });
+        try {
+            const list = await d2.get('/v1/jobs');
+            assert.equal(list.json.total, 3);
+            assert.deepEqual(list.json.jobs.map((j) => j.id), [c.id, b.id, a.id]);
+            assert.deepEqual(list.json.jobs.map((j) => j.name), ['c', 'b', 'long']);
+            const stored = list.json.jobs[2];
+            assert.ok(['queued', 'running'].includes(stored.state), stored.state);
+            assert.ok(stored.progress.step > 0, 'the store holds the running job\'s progress');
+            assert.ok(stored.progress.step <= live.progress.step);
+
+            const done = await waitFinal(d2, a.id, { timeout: 20000 });
+            t.diagnostic(`killed at step ${live.progress.step} (stored ${stored.progress.step}), ` +
+                `finished at step ${done.progress.step} after ${done.seconds.toFixed(2)} s`);
+            assert.equal(done.state, 'done', JSON.stringify(done));
+            assert.equal(done.stop_reason, 'time');
+            assert.ok(done.progress.step > live.progress.step, 'it continued past the step it was killed at');
+            assert.ok(done.seconds >= 6 - 0.05 && done.seconds < 9, `seconds ${done.seconds}`);
+            assert.equal(done.progress.fraction, 1);
+            assert.ok(done.started < done.finished);
+            await assertResumedHistory(d2, done, stored.progress.step);
+            await assertResumedFrames(d2, done);
+
+            // the two that never started run from their input, as the CLI does
+            const want = (await cli).summary;
+            for (const id of [b.id, c.id]) {
+                const job = await waitFinal(d2, id);
+                assert.equal(job.state, 'done');
+                assert.equal(job.progress.step, 150);
+                for (const k of ['ropelength', 'length', 'thickness', 'minrad', 'residual', 'struts', 'vertices'])
+                    assert.equal(job[k], want[k], `job ${id} ${k}`);
+            }
+        } finally {
+            await d2.stop();
+        }
+    });
+});
+
+describe('SIGTERM with a running job, and restart', () => {
+    test('exits 0 within 10 s; the job resumes and ends at its step budget', async (t) => {
+        const dir = tempDir('term');
+        const STEPS = 1600;
+        const d1 = await startDaemon({ workers: 1, dir });
+        t.after(() => d1.proc.kill('SIGKILL')); // when the test fails before the stop
+        const a = await submit(d1, { catalogue: '3.1', options: { resolution: 10, steps: STEPS } });
+        // stop it well into the run, where struts are active (3.1 at
+        // resolution 10 takes about 1 s for its first 1100 steps, 2 s for 1600)
+        await waitJob(d1, a.id, (j) => j.state === 'running' && j.progress.step >= 1000, { every: 10 });
+        const seconds = await d1.stop();
+        t.diagnostic(`SIGTERM to exit: ${seconds.toFixed(2)} s`);
+        assert.match(d1.output(), /SIGTERM: storing running jobs and stopping/);
+        assert.match(d1.output(), /tightknotd: stopped/);
+
+        const d2 = await startDaemon({ workers: 1, dir, db: d1.db });
+        try {
+            const stored = (await d2.get(`/v1/jobs/${a.id}`)).json;
+            assert.ok(['queued', 'running'].includes(stored.state), stored.state);
+            assert.ok(stored.progress.step > 0 && stored.progress.step < STEPS,
+                `stored at step ${stored.progress.step}`);
+            assert.equal(stored.finished, null);
+            const done = await waitFinal(d2, a.id, { timeout: 60000 });
+            t.diagnostic(`stopped at step ${stored.progress.step}, finished at ${done.progress.step}`);
+            assert.equal(done.state, 'done', JSON.stringify(done));
+            assert.equal(done.stop_reason, 'steps');
+            assert.equal(done.progress.step, STEPS, 'the resumed run ends at the step budget');
+            assert.equal(done.progress.fraction, 1);
+            await assertResumedHistory(d2, done, stored.progress.step);
+            const s = (await d2.get(`/v1/jobs/${a.id}/struts`)).json;
+            assert.equal(s.step, STEPS);
+            assert.equal(s.struts.length, done.struts);
+        } finally {
+            await d2.stop();
+        }
+    });
+});

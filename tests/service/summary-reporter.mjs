@@ -1,0 +1,25 @@
+// A node:test reporter that counts the tests that ran (leaves only: a
+// suite or a test with subtests is not counted again), prints "FAIL name"
+// for each failure, and ends with "service: N passed, M failed".  A test
+// file that fails outside any test counts as one failure.
+export default async function* summary(source) {
+    let passed = 0;
+    let failed = 0;
+    const childSeen = [];
+    for await (const event of source) {
+        if (event.type !== 'test:pass' && event.type !== 'test:fail') continue;
+        const { nesting, name, file, details } = event.data;
+        const leaf = !childSeen[nesting + 1];
+        childSeen[nesting + 1] = false;
+        childSeen[nesting] = true;
+        if (!leaf || details?.type === 'suite') continue;
+        if (event.type === 'test:pass') {
+            passed++;
+        } else {
+            failed++;
+            const where = file ? ` (${file.replace(/^.*\/tests\/service\//, '')})` : '';
+            yield `FAIL ${name}${where}\n`;
+        }
+    }
+    yield `service: ${passed} passed, ${failed} failed\n`;
+}
