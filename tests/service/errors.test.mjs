@@ -193,6 +193,14 @@ describe('bad JSON, bad options, wrong media type', () => {
         r = await d.post('/v1/jobs', { vect: 42 });
         assert.equal(r.status, 422);
         assert.equal(r.json.field, 'vect');
+        r = await d.post('/v1/jobs', { catalogue: '3.1', name: 'n'.repeat(128) });
+        assert.equal(r.status, 422, 'a name over 127 bytes (openapi.yaml: maxLength 127)');
+        assert.equal(r.json.field, 'name');
+        const longest = await submit(d, { catalogue: '3.1', name: 'n'.repeat(127), options: { steps: 1 } });
+        assert.equal(longest.name, 'n'.repeat(127));
+        r = await d.post(`/v1/jobs?autoscale=true&name=${'n'.repeat(128)}`, TRIANGLE, { type: 'text/plain' });
+        assert.equal(r.status, 422);
+        assert.equal(r.json.field, 'name');
         r = await d.post('/v1/jobs', { catalogue: 'no-such-knot' });
         assert.equal(r.status, 422);
         assert.equal(r.json.field, 'catalogue');

@@ -22,6 +22,13 @@ describe('cancelling (--workers 1)', () => {
             await running(d, a.id);
             const b = await submit(d, LONG);
             assert.equal((await d.get(`/v1/jobs/${b.id}`)).json.state, 'queued');
+            // before it starts, its curve is its input and it has no contacts
+            const input = (await d.get('/v1/catalogue/3.1')).json.vect;
+            assert.equal((await d.get(`/v1/jobs/${b.id}/vect`)).text, input);
+            const none = (await d.get(`/v1/jobs/${b.id}/struts`)).json;
+            assert.deepEqual([none.step, none.thickness, none.struts, none.kinks], [0, null, [], []]);
+            assert.deepEqual((await d.get(`/v1/jobs/${b.id}/history`)).json.steps, []);
+            assert.equal((await d.get(`/v1/jobs/${b.id}/frames`)).json.total, 0);
 
             // queued: cancelled at once
             const rb = await d.del(`/v1/jobs/${b.id}`);
