@@ -59,7 +59,7 @@ trap 'rm -f "$summary"' EXIT
 node --test \
     --test-reporter=spec --test-reporter-destination=stdout \
     --test-reporter=./tests/service/summary-reporter.mjs --test-reporter-destination="$summary" \
-    tests/service/
+    tests/service/*.test.mjs
 status=$?
 
 line=$(grep -E '^service: [0-9]+ passed, [0-9]+ failed$' "$summary" | tail -n 1)
