@@ -194,10 +194,19 @@ typedef struct job_run {
     double seconds_offset;
     history hist;
     double last_flush;      /* monotonic seconds */
-    size_t frames_flushed;  /* run snapshots already stored */
+    size_t frames_flushed;  /* run snapshots already stored (or skipped) */
     size_t frames_before;   /* frames stored before this run */
+    size_t frames_skip;     /* leading run snapshots not to store: 1 when a
+                               resumed run's start is a frame stored before */
     tk_error flush_error;
 } job_run;
+
+/* The frames of the job: those stored before this run and this run's. */
+static size_t job_frames(const job_run *jr)
+{
+    size_t nsnap = tk_run_snapshot_count(jr->run);
+    return jr->frames_before + (nsnap > jr->frames_skip ? nsnap - jr->frames_skip : 0);
+}
 
 static double job_fraction(const tk_job *job)
 {
@@ -233,7 +242,7 @@ static int flush_job(job_run *jr, const tk_job *job, bool final, tk_error *err)
                               (long long)job->id);
     }
     size_t nsnap = tk_run_snapshot_count(jr->run);
-    size_t nnew = nsnap - jr->frames_flushed;
+    size_t nnew = nsnap > jr->frames_flushed ? nsnap - jr->frames_flushed : 0;
     tk_store_frame *frames = nnew ? calloc(nnew, sizeof *frames) : NULL;
     if (!rc && nnew && !frames)
         rc = tk_error_set(err, TK_ENOMEM, "out of memory writing frames");
@@ -245,10 +254,10 @@ static int flush_job(job_run *jr, const tk_job *job, bool final, tk_error *err)
     }
     if (!rc) {
         tk_job copy = *job;
-        copy.frames = jr->frames_before + nsnap;
+        copy.frames = job_frames(jr);
         rc = tk_store_save(jr->slot->owner->store, &copy, curve, contacts, hist, frames, nnew,
                            err);
-        if (!rc)
+        if (!rc && nnew)
             jr->frames_flushed = nsnap;
     }
     (void)final;
@@ -274,7 +283,7 @@ static int on_step(const tk_step_report *s, void *user)
     slot->job.latest = r;
     slot->job.has_figures = true;
     slot->job.fraction = job_fraction(&slot->job);
-    slot->job.frames = jr->frames_before + tk_run_snapshot_count(jr->run);
+    slot->job.frames = job_frames(jr);
     tk_job copy = slot->job;
     bool stop = slot->cancel || j->stopping;
     pthread_mutex_unlock(&j->lock);
@@ -337,6 +346,13 @@ static int setup_run(tk_jobs *j, tk_job *job, job_run *jr, tk_error *err)
             history_load(&jr->hist, hist, jr->step_offset);
         free(hist);
         jr->frames_before = job->frames;
+        /* The run snapshots its start (its step 0, the job's step S), and
+         * then every `every` steps.  When S is a multiple of `every`, the
+         * frame of step S was stored with step S itself (the engine takes
+         * the snapshot before it reports the step), so the run's first
+         * snapshot would repeat it. */
+        if (opts.snapshot_every > 0 && jr->step_offset % (long)opts.snapshot_every == 0)
+            jr->frames_skip = jr->frames_flushed = 1;
     }
     if (!rc)
         rc = tk_run_new(curve, &opts, &jr->run, err);

@@ -136,3 +136,35 @@ describe('SIGTERM with a running job, and restart', () => {
         }
     });
 });
+
+describe('frames across a restart', () => {
+    test('every 1: one frame per step, none repeated, after SIGTERM and resume', async (t) => {
+        const dir = tempDir('frames');
+        const knot = await generate(dir, 'torus23.vect', ['torus', '2', '3', '--vertices', '40']);
+        const d1 = await startDaemon({ workers: 1, dir });
+        t.after(() => d1.proc.kill('SIGKILL'));
+        const a = await submit(d1, knot.text, { query: 'time=2&every=1' });
+        await waitJob(d1, a.id, (j) => j.state === 'running' && j.progress.step >= 20, { every: 5 });
+        await d1.stop();
+        const d2 = await startDaemon({ workers: 1, dir, db: d1.db });
+        try {
+            const stored = (await d2.get(`/v1/jobs/${a.id}`)).json;
+            assert.equal(stored.finished, null, 'stopped before it finished');
+            const done = await waitFinal(d2, a.id);
+            t.diagnostic(`stopped at step ${stored.progress.step}, finished at ${done.progress.step} (${done.stop_reason})`);
+            assert.equal(done.state, 'done');
+            assert.ok(done.progress.step > stored.progress.step);
+            assert.equal(done.frames, done.progress.step + 1, 'frames of steps 0 to N');
+            const steps = [];
+            for (let offset = 0; ; offset += 200) {
+                const r = (await d2.get(`/v1/jobs/${a.id}/frames?offset=${offset}&limit=200`)).json;
+                assert.equal(r.total, done.frames);
+                steps.push(...r.frames.map((f) => f.step));
+                if (r.frames.length < 200) break;
+            }
+            assert.deepEqual(steps, Array.from({ length: done.progress.step + 1 }, (_, i) => i));
+        } finally {
+            await d2.stop();
+        }
+    });
+});
