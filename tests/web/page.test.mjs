@@ -1,0 +1,388 @@
+// The page in a real browser (headless Chromium) against the real daemon:
+// submit through the form, watch, look at the tube, the struts, the contact
+// map, replay, cancel, download, and the messages for rejected input.
+//
+// Environment (relative paths from the current directory; the defaults
+// from the repository root):
+//   TK_DAEMON     the daemon (default build/tightknotd)
+//   TK_CATALOGUE  the catalogue directory (default ../shared/catalogue)
+//   TK_WEB        the built page (default build/web, see tools/build-web.sh)
+//   TK_CHROMIUM   the browser (default /usr/bin/chromium)
+// Screenshots go to test-artifacts/web/.
+
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import { mkdtempSync, mkdirSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), '..', '..');
+const fromEnv = (name, dflt) =>
+    process.env[name] ? resolve(process.cwd(), process.env[name]) : resolve(ROOT, dflt);
+const DAEMON = fromEnv('TK_DAEMON', 'build/tightknotd');
+const CATALOGUE = fromEnv('TK_CATALOGUE', '../shared/catalogue');
+const WEB = fromEnv('TK_WEB', 'build/web');
+const CHROMIUM = process.env.TK_CHROMIUM || '/usr/bin/chromium';
+const ARTIFACTS = join(ROOT, 'test-artifacts', 'web');
+
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+let daemon, base, browser, page, tmp;
+const pageErrors = [];
+const consoleErrors = [];
+const shared = {};  // what one test leaves for the next
+
+async function startDaemon() {
+    tmp = mkdtempSync(join(tmpdir(), 'tk-web-'));
+    const args = ['--port', '0', '--db', join(tmp, 'jobs.db'), '--catalogue', CATALOGUE, '--web', WEB, '--workers', '2'];
+    daemon = spawn(DAEMON, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+    let stderr = '';
+    daemon.stderr.on('data', (d) => { stderr += d; });
+    return new Promise((resolveUrl, reject) => {
+        let out = '';
+        const timer = setTimeout(() => reject(new Error(`the daemon did not start: ${stderr}`)), 15000);
+        daemon.stdout.on('data', (d) => {
+            out += d;
+            const m = /(http:\/\/[^\s/]+)/.exec(out.split('\n')[0] || '');
+            if (m && out.includes('\n')) { clearTimeout(timer); resolveUrl(m[1]); }
+        });
+        daemon.on('exit', (code) => { clearTimeout(timer); reject(new Error(`the daemon exited (${code}): ${stderr}`)); });
+    });
+}
+
+async function api(path, init) {
+    const res = await fetch(base + path, init);
+    const body = (res.headers.get('content-type') || '').includes('json') ? await res.json() : await res.text();
+    return { status: res.status, body };
+}
+
+// Reads the 3-D canvas back: the share of pixels that differ from the
+// background, the number of distinct colours (quantised), and a coarse
+// 64 x 48 thumbnail to compare pictures with.
+async function canvasPixels() {
+    return page.evaluate(() => {
+        window.tightknot.view.renderNow();
+        const src = document.querySelector('#view3d canvas');
+        const w = src.width, h = src.height;
+        const c = document.createElement('canvas');
+        c.width = w; c.height = h;
+        const g = c.getContext('2d', { willReadFrequently: true });
+        g.drawImage(src, 0, 0);
+        const d = g.getImageData(0, 0, w, h).data;
+        const bg = [d[0], d[1], d[2]];
+        let other = 0;
+        const colours = new Set();
+        for (let i = 0; i < d.length; i += 4) {
+            if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 12) other++;
+            colours.add(((d[i] >> 3) << 10) | ((d[i + 1] >> 3) << 5) | (d[i + 2] >> 3));
+        }
+        const t = document.createElement('canvas');
+        t.width = 64; t.height = 48;
+        const tg = t.getContext('2d', { willReadFrequently: true });
+        tg.drawImage(src, 0, 0, 64, 48);
+        const thumb = Array.from(tg.getImageData(0, 0, 64, 48).data);
+        return { w, h, share: other / (w * h), colours: colours.size, thumb };
+    });
+}
+
+// The mean absolute difference of two thumbnails, per channel value.
+function difference(a, b) {
+    let s = 0;
+    for (let i = 0; i < a.thumb.length; i++) s += Math.abs(a.thumb[i] - b.thumb[i]);
+    return s / a.thumb.length;
+}
+
+async function waitJob(id, states, ms = 120000) {
+    const end = Date.now() + ms;
+    for (;;) {
+        const { body } = await api(`/v1/jobs/${id}`);
+        if (states.includes(body.state)) return body;
+        if (Date.now() > end) throw new Error(`job ${id} is still ${body.state}`);
+        await sleep(200);
+    }
+}
+
+// Submits the form and returns the new job's id, as the page reports it.
+// The page drops the last message and job number as soon as it submits.
+async function submitForm() {
+    await page.click('#submit-button');
+    await page.waitForFunction(() => {
+        const m = document.getElementById('submit-message');
+        return !m.hidden && (m.classList.contains('error') || m.dataset.job);
+    });
+    const id = await page.locator('#submit-message').getAttribute('data-job');
+    const isError = await page.locator('#submit-message.error').count();
+    assert.equal(isError, 0, `the page reports: ${await page.locator('#submit-message').innerText()}`);
+    return Number(id);
+}
+
+async function setOptions(o) {
+    for (const [k, v] of Object.entries(o)) await page.fill(`#opt-${k}`, String(v));
+}
+
+before(async () => {
+    mkdirSync(ARTIFACTS, { recursive: true });
+    base = await startDaemon();
+    browser = await chromium.launch({
+        executablePath: CHROMIUM,
+        headless: true,
+        // Root needs --no-sandbox; WebGL runs on SwiftShader without a GPU.
+        args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+    });
+    page = await browser.newPage({ viewport: { width: 1366, height: 768 }, acceptDownloads: true });
+    page.on('pageerror', (e) => pageErrors.push(e.message));
+    page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+    page.setDefaultTimeout(30000);
+});
+
+after(async () => {
+    await browser?.close();
+    if (daemon && daemon.exitCode === null) {
+        const gone = new Promise((r) => daemon.on('exit', r));
+        daemon.kill('SIGTERM');
+        await Promise.race([gone, sleep(10000)]);
+        if (daemon.exitCode === null) daemon.kill('SIGKILL');
+    }
+    if (tmp) rmSync(tmp, { recursive: true, force: true });
+});
+
+test('the page and its libraries come from the daemon, with the catalogue', async () => {
+    const requests = [];
+    page.on('request', (r) => requests.push(r.url()));
+    await page.goto(base + '/');
+    const { body: cat } = await api('/v1/catalogue');
+    await page.waitForFunction((n) => document.querySelectorAll('#catalogue-select option').length === n, cat.count);
+    assert.equal(await page.title(), 'tightknot');
+    assert.ok(requests.some((u) => u.endsWith('/vendor/three/build/three.module.js')), 'three.js is loaded');
+    const foreign = requests.filter((u) => !u.startsWith(base));
+    assert.deepEqual(foreign, [], 'no request leaves the daemon');
+});
+
+test('a catalogue knot submitted through the form is tightened and shown', async () => {
+    await page.click('#tab-catalogue');
+    await page.fill('#catalogue-filter', '3.1');
+    await page.selectOption('#catalogue-select', '3.1');
+    await setOptions({ resolution: 5, steps: 300, every: 10, time: 0, residual: 0 });
+    const id = await submitForm();
+    shared.trefoil = id;
+    await page.waitForSelector('#job-state[data-state="done"]', { timeout: 120000 });
+    await page.waitForSelector('#job[data-phase="final"]');
+    await page.waitForTimeout(300);
+    await page.screenshot({ path: join(ARTIFACTS, 'done.png'), fullPage: true });
+
+    const { body: job } = await api(`/v1/jobs/${id}`);
+    const { body: contacts } = await api(`/v1/jobs/${id}/struts`);
+    assert.equal(job.state, 'done');
+    assert.equal(job.options.steps, 300);
+    assert.equal(job.options.every, 10);
+    assert.ok(contacts.struts.length > 0, 'a tightened trefoil has struts');
+    assert.equal(await page.locator('#strut-table tbody tr').count(), contacts.struts.length, 'one table row per strut');
+    assert.equal(await page.locator('#contact-map .strut-mark').count(), contacts.struts.length, 'one contact-map mark per strut');
+    assert.equal(await page.locator('#contact-map .kink-mark').count(), contacts.kinks.length, 'one mark per kink');
+    assert.equal(await page.locator('#kink-table tbody tr').count(), contacts.kinks.length);
+    // the components' boundaries: none for a knot
+    assert.equal(await page.locator('#contact-map .boundary').count(), 0);
+
+    assert.equal(await page.locator('#fig-struts').innerText(), String(job.struts));
+    assert.equal(await page.locator('#fig-ropelength').innerText(), job.ropelength.toFixed(3));
+    assert.equal(await page.locator('#fig-step').innerText(), `${job.progress.step} / 300`);
+    const d = await page.locator('#chart path.curve').getAttribute('d');
+    assert.ok((d.match(/L/g) || []).length >= 2, 'the chart draws the history');
+
+    const row = page.locator(`#jobs-table tbody tr[data-id="${id}"]`);
+    await row.waitFor();
+    assert.match(await row.innerText(), /done/);
+    assert.match(await row.innerText(), new RegExp(job.ropelength.toFixed(3).replace('.', '\\.')));
+
+    const px = await canvasPixels();
+    assert.ok(px.w > 300 && px.h > 200, `the canvas is ${px.w}x${px.h}`);
+    assert.ok(px.share > 0.03, `the 3-D view is not blank (${(100 * px.share).toFixed(1)}% drawn)`);
+    assert.ok(px.colours > 20, `the tube is shaded (${px.colours} colours)`);
+    shared.finalPixels = px;
+});
+
+test('hovering a strut row highlights that strut in 3-D and on the map', async () => {
+    const beforePx = await canvasPixels();
+    const row = page.locator('#strut-table tbody tr').first();
+    const index = await row.getAttribute('data-index');
+    await row.hover();
+    await page.waitForTimeout(200);
+    const hoverPx = await canvasPixels();
+    assert.ok(difference(beforePx, hoverPx) > 0.05, 'the highlight changes the picture');
+    assert.equal(await page.locator(`#contact-map .strut-mark.hot[data-index="${index}"]`).count(), 1);
+    await page.mouse.move(5, 5);
+    await page.hover('#job-name');
+    await page.waitForTimeout(200);
+    assert.equal(await page.locator('#contact-map .strut-mark.hot').count(), 0);
+});
+
+test('the strut table sorts by a column when its header is clicked', async () => {
+    const id = shared.trefoil;
+    const { body: contacts } = await api(`/v1/jobs/${id}/struts`);
+    const forces = contacts.struts.map((s) => s.force);
+    const column = async () => (await page.locator('#strut-table tbody tr td:nth-child(7)').allInnerTexts()).map(Number);
+    await page.click('#strut-table th[data-key="force"]');
+    assert.equal(await page.locator('#strut-table th[data-key="force"]').getAttribute('aria-sort'), 'ascending');
+    const up = await column();
+    assert.deepEqual(up, [...up].sort((a, b) => a - b));
+    assert.equal(up.length, forces.length);
+    await page.click('#strut-table th[data-key="force"]');
+    assert.equal(await page.locator('#strut-table th[data-key="force"]').getAttribute('aria-sort'), 'descending');
+    const down = await column();
+    assert.deepEqual(down, [...down].sort((a, b) => b - a));
+    assert.ok(Math.abs(down[0] - Math.max(...forces)) <= 1e-3 * Math.max(...forces), 'the largest force comes first');
+    await page.click('#strut-table th[data-key="index"]');
+});
+
+test('replay draws the run\'s frames', async () => {
+    const id = shared.trefoil;
+    const { body: frames } = await api(`/v1/jobs/${id}/frames?limit=1`);
+    assert.ok(frames.total >= 2, 'the run kept frames');
+    const slider = page.locator('#replay-slider');
+    await page.waitForFunction(() => !document.getElementById('replay-slider').disabled);
+    assert.equal(Number(await slider.getAttribute('max')), frames.total - 1);
+
+    const finalPx = await canvasPixels();
+    await slider.focus();
+    await page.keyboard.press('Home');
+    await page.waitForFunction(() => /step 0\b/.test(document.getElementById('replay-label').textContent));
+    await page.evaluate(() => window.scrollTo(0, 0));
+    const firstPx = await canvasPixels();
+    assert.ok(difference(finalPx, firstPx) > 0.5, 'the first frame differs from the final curve');
+    assert.ok(firstPx.share > 0.03, 'the first frame is drawn');
+
+    await page.click('#replay-play');
+    await page.waitForFunction(() => {
+        const m = /step (\d+)/.exec(document.getElementById('replay-label').textContent);
+        return m && Number(m[1]) >= 60;
+    });
+    await page.screenshot({ path: join(ARTIFACTS, 'replay.png') });
+    const playingPx = await canvasPixels();
+    assert.ok(difference(firstPx, playingPx) > 0.5, 'playing moves on from the first frame');
+    await page.waitForFunction(() => document.getElementById('replay-play').textContent.includes('Play'), null, { timeout: 30000 });
+    assert.equal(Number(await slider.inputValue()), frames.total - 1, 'the replay ends at the last frame');
+
+    await page.click('#replay-final');
+    await page.waitForFunction(() => document.getElementById('view3d-label').textContent.startsWith('stored curve'));
+});
+
+test('the final VECT and the struts JSON download', async () => {
+    const id = shared.trefoil;
+    const [vect] = await Promise.all([page.waitForEvent('download'), page.click('#job-download-vect')]);
+    const text = readFileSync(await vect.path(), 'utf8');
+    assert.match(text, /^VECT/);
+    assert.equal(text, (await api(`/v1/jobs/${id}/vect`)).body);
+    assert.match(vect.suggestedFilename(), /\.vect$/);
+    const [json] = await Promise.all([page.waitForEvent('download'), page.click('#job-download-struts')]);
+    const got = JSON.parse(readFileSync(await json.path(), 'utf8'));
+    assert.deepEqual(got, (await api(`/v1/jobs/${id}/struts`)).body);
+});
+
+test('a bad VECT is rejected with the problem\'s detail and line', async () => {
+    const bad = 'VECT\n1 4 0\n-4\n0\n0 0 0\n4 0 0\nfoo 4 0\n0 4 0\n';
+    const direct = await api('/v1/jobs', {
+        method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ vect: bad }),
+    });
+    assert.equal(direct.status, 422);
+    assert.equal(direct.body.line, 7);
+    const totalBefore = (await api('/v1/jobs?limit=1')).body.total;
+
+    await page.click('#tab-vect');
+    await page.fill('#vect-text', bad);
+    await page.click('#submit-button');
+    const box = page.locator('#submit-message.error');
+    await box.waitFor();
+    const text = await box.innerText();
+    assert.ok(text.includes(direct.body.detail), `the message shows the detail: ${text}`);
+    assert.match(text, /line 7\b/);
+    assert.equal(await box.locator('.where').getAttribute('data-line'), '7');
+    // the cursor is put on the bad line
+    const sel = await page.$eval('#vect-text', (t) => t.value.slice(t.selectionStart, t.selectionEnd));
+    assert.equal(sel, 'foo 4 0');
+    assert.equal((await api('/v1/jobs?limit=1')).body.total, totalBefore, 'no job was stored');
+    await page.screenshot({ path: join(ARTIFACTS, 'bad-vect.png') });
+
+    // an option the server refuses is named too
+    await page.fill('#vect-text', 'VECT\n1 3 0\n-3\n0\n0 0 0\n4 0 0\n0 4 0\n');
+    await page.fill('#opt-resolution', '-1');
+    await page.click('#submit-button');
+    await page.waitForFunction(() => /option resolution/.test(document.getElementById('submit-message').textContent));
+    await page.fill('#opt-resolution', '5');
+});
+
+test('an uploaded VECT file is submitted', async () => {
+    await page.click('#tab-vect');
+    await page.fill('#vect-text', '');
+    const square = 'VECT\n1 4 0\n-4\n0\n0 0 0\n3 0 0\n3 3 0\n0 3 0\n';
+    await page.setInputFiles('#vect-file', { name: 'square.vect', mimeType: 'text/plain', buffer: Buffer.from(square) });
+    await page.waitForFunction(() => document.getElementById('vect-text').value.startsWith('VECT'));
+    assert.equal(await page.getAttribute('#opt-name', 'placeholder'), 'square');
+    await setOptions({ resolution: 0, steps: 20, every: 0 });
+    const id = await submitForm();
+    const job = await waitJob(id, ['done', 'failed']);
+    assert.equal(job.name, 'square', 'the job is named after the file');
+    assert.equal(job.state, 'done');
+    await page.waitForSelector('#job[data-phase="final"]');
+    assert.match(await page.locator('#replay-label').innerText(), /no frames/);
+});
+
+test('a torus link generated in the page is thick enough and has its components', async () => {
+    await page.click('#tab-torus');
+    await page.fill('#torus-p', '2');
+    await page.fill('#torus-q', '4');
+    await page.fill('#torus-n', '60');
+    await page.waitForFunction(() => /2-component link/.test(document.getElementById('torus-info').textContent));
+    await setOptions({ resolution: 0, steps: 30, every: 10 });
+    const id = await submitForm();
+    const job = await waitJob(id, ['done', 'failed']);
+    assert.equal(job.state, 'done', job.error || '');
+    assert.equal(job.components, 2);
+    assert.equal(job.vertices, 120);
+    assert.equal(job.name, 'T(2,4)');
+    await page.waitForSelector('#job[data-phase="final"]');
+    const { body: contacts } = await api(`/v1/jobs/${id}/struts`);
+    assert.equal(await page.locator('#contact-map .boundary').count(), 2, 'one boundary line each way');
+    assert.equal(await page.locator('#contact-map .strut-mark').count(), contacts.struts.length);
+    const px = await canvasPixels();
+    assert.ok(px.share > 0.03);
+    await page.screenshot({ path: join(ARTIFACTS, 'torus-link.png'), fullPage: true });
+});
+
+test('a running job shows live figures and can be cancelled', async () => {
+    await page.click('#tab-catalogue');
+    await page.fill('#catalogue-filter', '');
+    await page.selectOption('#catalogue-select', '8.19');
+    await setOptions({ resolution: 10, steps: 1000000, time: 120, every: 50 });
+    const id = await submitForm();
+    await page.waitForSelector('#job-state[data-state="running"]', { timeout: 60000 });
+    const stepOf = async () => Number((await page.locator('#fig-step').innerText()).split('/')[0]);
+    await page.waitForFunction(() => Number(document.getElementById('fig-step').textContent.split('/')[0]) > 0);
+    const s1 = await stepOf();
+    await page.waitForFunction((s) => Number(document.getElementById('fig-step').textContent.split('/')[0]) > s, s1);
+    await page.screenshot({ path: join(ARTIFACTS, 'running.png') });
+    await page.click('#job-cancel');
+    await page.waitForSelector('#job-state[data-state="cancelled"]', { timeout: 30000 });
+    const job = await waitJob(id, ['cancelled']);
+    assert.equal(job.stop_reason, 'cancelled');
+    assert.ok(await page.locator('#job-cancel').isDisabled());
+    await page.waitForSelector('#job[data-phase="final"]');
+});
+
+test('selecting a job in the list shows it', async () => {
+    const row = page.locator(`#jobs-table tbody tr[data-id="${shared.trefoil}"]`);
+    await row.click();
+    await page.waitForSelector('#job[data-phase="final"]');
+    assert.equal(await page.locator('#job-id').innerText(), `#${shared.trefoil}`);
+    assert.equal(await row.getAttribute('aria-selected'), 'true');
+    const { body: contacts } = await api(`/v1/jobs/${shared.trefoil}/struts`);
+    assert.equal(await page.locator('#strut-table tbody tr').count(), contacts.struts.length);
+    assert.match(page.url(), new RegExp(`#job=${shared.trefoil}$`));
+});
+
+test('no script errors', () => {
+    assert.deepEqual(pageErrors, []);
+    assert.deepEqual(consoleErrors.filter((e) => !/status of 4\d\d/.test(e)), []);
+});
