@@ -24,6 +24,7 @@ const state = {
     contacts: null,
     curve: null,
     history: [],
+    live: [],           // polled figures newer than the stored history
     frames: [],         // [{ step, comps }]
     replayIndex: -1,    // -1: the stored (final) curve with its struts
     playTimer: null,
@@ -39,6 +40,8 @@ let view = null;
 const fixed = (v, d) => (v == null || !Number.isFinite(v) ? '–' : v.toFixed(d));
 const prec = (v, d) => (v == null || !Number.isFinite(v) ? '–' : (+v.toPrecision(d)).toString());
 const sci = (v) => (v == null || !Number.isFinite(v) ? '–' : v === 0 ? '0' : Math.abs(v) >= 0.01 && Math.abs(v) < 1000 ? v.toPrecision(3) : v.toExponential(2));
+
+const compact = (n) => (n >= 1e6 && n % 1e5 === 0 ? `${n / 1e6}M` : n >= 1e4 && n % 100 === 0 ? `${n / 1e3}k` : `${n}`);
 
 function fileName(job, ext) {
     const base = (job.name || 'job').replace(/[^A-Za-z0-9._-]+/g, '_');
@@ -256,6 +259,12 @@ async function refreshJobs() {
 
 function renderJobs(list) {
     const tbody = $('jobs-table').tBodies[0];
+    // Rows are rebuilt only when something shown changed, so that a click
+    // never lands on a row being replaced.
+    const key = JSON.stringify([state.selected, list.total, list.offset,
+        list.jobs.map((j) => [j.id, j.name, j.state, j.ropelength])]);
+    if (key === state.jobsKey) return;
+    state.jobsKey = key;
     tbody.replaceChildren();
     for (const j of list.jobs) {
         const tr = document.createElement('tr');
@@ -322,6 +331,7 @@ function selectJob(id) {
     state.contacts = null;
     state.curve = null;
     state.history = [];
+    state.live = [];
     state.frames = [];
     state.replayIndex = -1;
     state.hot = -1;
@@ -410,7 +420,18 @@ function showJob(job) {
         a.setAttribute('aria-disabled', String(job.state === 'queued'));
     }
     const steps = job.options.steps;
-    $('fig-step').textContent = steps ? `${job.progress.step} / ${steps}` : `${job.progress.step}`;
+    $('fig-step-label').textContent = steps ? `step of ${compact(steps)}` : 'step';
+    $('fig-step').textContent = `${job.progress.step}`;
+    // The history is stored every few seconds; the polled figures fill the
+    // chart in between.
+    const lastStored = state.history.length ? state.history[state.history.length - 1].step : -1;
+    if (Number.isFinite(job.ropelength) && job.progress.step > lastStored) {
+        const live = state.live;
+        if (!live.length || live[live.length - 1].step < job.progress.step) {
+            live.push({ step: job.progress.step, ropelength: job.ropelength });
+            drawChart();
+        }
+    }
     $('fig-ropelength').textContent = fixed(job.ropelength, 3);
     $('fig-thickness').textContent = prec(job.thickness, 6);
     $('fig-minrad').textContent = prec(job.minrad, 5);
@@ -431,13 +452,16 @@ async function loadData(job, live) {
     state.curve = { comps: parseVect(doc.vect), step: doc.step };
     state.contacts = contacts;
     state.history = hist.steps;
+    const lastStored = hist.steps.length ? hist.steps[hist.steps.length - 1].step : -1;
+    state.live = state.live.filter((s) => s.step > lastStored);
     drawChart();
     renderStruts();
     if (state.replayIndex < 0) showFinal();
 }
 
 function drawChart() {
-    drawHistory($('chart'), state.history);
+    const mark = state.replayIndex >= 0 ? state.frames[state.replayIndex]?.step : null;
+    drawHistory($('chart'), state.history.concat(state.live), mark);
 }
 
 // The stored curve with its struts.
@@ -455,6 +479,7 @@ function showFinal() {
     const n = state.contacts?.struts.length ?? 0;
     $('view3d-label').textContent = `stored curve, step ${state.curve.step} · ${n} strut${n === 1 ? '' : 's'}`;
     $('replay-final').disabled = true;
+    drawChart();
     if (state.frames.length) {
         $('replay-slider').value = state.frames.length - 1;
         $('replay-label').textContent = `${state.frames.length} frames`;
@@ -599,6 +624,7 @@ function showFrame(i) {
     $('replay-label').textContent = `frame ${i + 1} / ${state.frames.length} · step ${f.step}`;
     $('view3d-label').textContent = `replay: step ${f.step}`;
     $('replay-final').disabled = false;
+    drawChart();
 }
 
 function play() {

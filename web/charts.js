@@ -26,7 +26,8 @@ const short = (v) => {
     return `${+v.toPrecision(4)}`;
 };
 
-export function drawHistory(svg, steps) {
+// mark: a step to point out (the replay's), or null.
+export function drawHistory(svg, steps, mark = null) {
     svg.replaceChildren();
     const W = 360, H = 170, L = 44, R = 10, T = 10, B = 24;
     const pts = (steps || []).filter((s) => Number.isFinite(s.ropelength));
@@ -52,6 +53,9 @@ export function drawHistory(svg, steps) {
     svg.append(el('line', { x1: L, x2: L, y1: T, y2: H - B, class: 'axis' }));
     svg.append(el('line', { x1: L, x2: W - R, y1: H - B, y2: H - B, class: 'axis' }));
     svg.append(el('text', { x: W - R, y: H - 2, 'text-anchor': 'end' }, 'step'));
+    if (mark != null && mark >= x0 && mark <= x1) {
+        svg.append(el('line', { x1: sx(mark), x2: sx(mark), y1: T, y2: H - B, class: 'marker' }));
+    }
     const d = pts.map((s, i) => `${i ? 'L' : 'M'}${sx(s.step).toFixed(1)},${sy(s.ropelength).toFixed(1)}`).join('');
     svg.append(el('path', { d, class: 'curve' }));
     const last = pts[pts.length - 1];
@@ -89,6 +93,9 @@ export function drawContactMap(svg, contacts, { colour, onHover } = {}) {
         svg.append(el('line', { y1: Y(c.start), y2: Y(c.start), x1: M, x2: M + span, class: 'boundary' }));
     }
     const struts = contacts.struts || [];
+    if (!struts.length && !(contacts.kinks || []).length) {
+        svg.append(el('text', { x: M + span / 2, y: E + span / 2, 'text-anchor': 'middle', class: 'nodata' }, 'no contacts yet'));
+    }
     const r = struts.length > 400 ? 2 : 3;
     const mirrors = el('g');
     const marks = el('g');

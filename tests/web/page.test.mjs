@@ -188,7 +188,8 @@ test('a catalogue knot submitted through the form is tightened and shown', async
 
     assert.equal(await page.locator('#fig-struts').innerText(), String(job.struts));
     assert.equal(await page.locator('#fig-ropelength').innerText(), job.ropelength.toFixed(3));
-    assert.equal(await page.locator('#fig-step').innerText(), `${job.progress.step} / 300`);
+    assert.equal(await page.locator('#fig-step').innerText(), String(job.progress.step));
+    assert.equal(await page.locator('#fig-step-label').innerText(), 'step of 300');
     const d = await page.locator('#chart path.curve').getAttribute('d');
     assert.ok((d.match(/L/g) || []).length >= 2, 'the chart draws the history');
 
@@ -313,20 +314,25 @@ test('a bad VECT is rejected with the problem\'s detail and line', async () => {
     await page.fill('#opt-resolution', '5');
 });
 
-test('an uploaded VECT file is submitted', async () => {
+test('an uploaded VECT file is submitted, and its kinks are shown', async () => {
     await page.click('#tab-vect');
     await page.fill('#vect-text', '');
-    const square = 'VECT\n1 4 0\n-4\n0\n0 0 0\n3 0 0\n3 3 0\n0 3 0\n';
-    await page.setInputFiles('#vect-file', { name: 'square.vect', mimeType: 'text/plain', buffer: Buffer.from(square) });
+    // a triangle tightens into three kinks
+    const triangle = 'VECT\n1 3 0\n-3\n0\n0 0 0\n4 0 0\n0 4 0\n';
+    await page.setInputFiles('#vect-file', { name: 'triangle.vect', mimeType: 'text/plain', buffer: Buffer.from(triangle) });
     await page.waitForFunction(() => document.getElementById('vect-text').value.startsWith('VECT'));
-    assert.equal(await page.getAttribute('#opt-name', 'placeholder'), 'square');
-    await setOptions({ resolution: 0, steps: 20, every: 0 });
+    assert.equal(await page.getAttribute('#opt-name', 'placeholder'), 'triangle');
+    await setOptions({ resolution: 0, steps: 100, every: 0 });
     const id = await submitForm();
     const job = await waitJob(id, ['done', 'failed']);
-    assert.equal(job.name, 'square', 'the job is named after the file');
+    assert.equal(job.name, 'triangle', 'the job is named after the file');
     assert.equal(job.state, 'done');
     await page.waitForSelector('#job[data-phase="final"]');
     assert.match(await page.locator('#replay-label').innerText(), /no frames/);
+    const { body: contacts } = await api(`/v1/jobs/${id}/struts`);
+    assert.ok(contacts.kinks.length > 0);
+    assert.equal(await page.locator('#contact-map .kink-mark').count(), contacts.kinks.length);
+    assert.equal(await page.locator('#kink-table tbody tr').count(), contacts.kinks.length);
 });
 
 test('a torus link generated in the page is thick enough and has its components', async () => {
@@ -358,10 +364,12 @@ test('a running job shows live figures and can be cancelled', async () => {
     await setOptions({ resolution: 10, steps: 1000000, time: 120, every: 50 });
     const id = await submitForm();
     await page.waitForSelector('#job-state[data-state="running"]', { timeout: 60000 });
-    const stepOf = async () => Number((await page.locator('#fig-step').innerText()).split('/')[0]);
-    await page.waitForFunction(() => Number(document.getElementById('fig-step').textContent.split('/')[0]) > 0);
+    const stepOf = async () => Number(await page.locator('#fig-step').innerText());
+    await page.waitForFunction(() => Number(document.getElementById('fig-step').textContent) > 0);
     const s1 = await stepOf();
-    await page.waitForFunction((s) => Number(document.getElementById('fig-step').textContent.split('/')[0]) > s, s1);
+    await page.waitForFunction((s) => Number(document.getElementById('fig-step').textContent) > s, s1);
+    // the chart follows the polled figures between stored histories
+    await page.waitForFunction(() => (document.querySelector('#chart path.curve')?.getAttribute('d').match(/L/g) || []).length >= 2);
     await page.screenshot({ path: join(ARTIFACTS, 'running.png') });
     await page.click('#job-cancel');
     await page.waitForSelector('#job-state[data-state="cancelled"]', { timeout: 30000 });
