@@ -194,18 +194,49 @@ typedef struct job_run {
     double seconds_offset;
     history hist;
     double last_flush;      /* monotonic seconds */
-    size_t frames_flushed;  /* run snapshots already stored (or skipped) */
-    size_t frames_before;   /* frames stored before this run */
-    size_t frames_skip;     /* leading run snapshots not to store: 1 when a
-                               resumed run's start is a frame stored before */
+    size_t frames_stored;   /* frames of the job in the store */
+    long frame_after;       /* frames are due at multiples of `every` after
+                               this step (the resume step: its frame, if
+                               due, was stored with it) */
+    size_t per_frame;       /* doubles per frame */
+    long *pending_steps;    /* frames taken since the last write */
+    double *pending_xyz;
+    size_t pending, pending_cap;
     tk_error flush_error;
 } job_run;
 
-/* The frames of the job: those stored before this run and this run's. */
+/* The frames of the job: stored and pending. */
 static size_t job_frames(const job_run *jr)
 {
-    size_t nsnap = tk_run_snapshot_count(jr->run);
-    return jr->frames_before + (nsnap > jr->frames_skip ? nsnap - jr->frames_skip : 0);
+    return jr->frames_stored + jr->pending;
+}
+
+/* Keeps the curve as a frame when the job's step is on the `every` grid.
+ * The worker takes the frames itself (the engine's snapshots stay off):
+ * they stay on the grid of the job's steps across a resume, and a long
+ * run holds only the frames since the last write. */
+static void take_frame(job_run *jr, long every, long step)
+{
+    if (every <= 0 || step <= jr->frame_after || step % every != 0)
+        return;
+    const tk_curve *c = tk_run_curve(jr->run);
+    size_t per = 3 * c->nvert;
+    if (jr->pending == jr->pending_cap) {
+        size_t cap = jr->pending_cap ? 2 * jr->pending_cap : 8;
+        long *steps = realloc(jr->pending_steps, cap * sizeof *steps);
+        if (steps)
+            jr->pending_steps = steps;
+        double *xyz = steps ? realloc(jr->pending_xyz, cap * per * sizeof *xyz) : NULL;
+        if (xyz)
+            jr->pending_xyz = xyz;
+        if (!steps || !xyz)
+            return; /* out of memory: this frame is left out */
+        jr->pending_cap = cap;
+    }
+    jr->per_frame = per;
+    memcpy(jr->pending_xyz + jr->pending * per, c->xyz, per * sizeof(double));
+    jr->pending_steps[jr->pending++] = step;
+    jr->frame_after = step;
 }
 
 static double job_fraction(const tk_job *job)
@@ -241,24 +272,24 @@ static int flush_job(job_run *jr, const tk_job *job, bool final, tk_error *err)
             rc = tk_error_set(err, TK_ENOMEM, "out of memory writing job %lld",
                               (long long)job->id);
     }
-    size_t nsnap = tk_run_snapshot_count(jr->run);
-    size_t nnew = nsnap > jr->frames_flushed ? nsnap - jr->frames_flushed : 0;
+    size_t nnew = jr->pending;
     tk_store_frame *frames = nnew ? calloc(nnew, sizeof *frames) : NULL;
     if (!rc && nnew && !frames)
         rc = tk_error_set(err, TK_ENOMEM, "out of memory writing frames");
     for (size_t i = 0; !rc && i < nnew; i++) {
-        long step = 0;
-        frames[i].xyz = tk_run_snapshot(jr->run, jr->frames_flushed + i, &step);
-        frames[i].step = jr->step_offset + step;
-        frames[i].count = 3 * c->nvert;
+        frames[i].xyz = jr->pending_xyz + i * jr->per_frame;
+        frames[i].step = jr->pending_steps[i];
+        frames[i].count = jr->per_frame;
     }
     if (!rc) {
         tk_job copy = *job;
         copy.frames = job_frames(jr);
         rc = tk_store_save(jr->slot->owner->store, &copy, curve, contacts, hist, frames, nnew,
                            err);
-        if (!rc && nnew)
-            jr->frames_flushed = nsnap;
+        if (!rc) {
+            jr->frames_stored += nnew;
+            jr->pending = 0;
+        }
     }
     (void)final;
     free(frames);
@@ -277,6 +308,7 @@ static int on_step(const tk_step_report *s, void *user)
     r.step += jr->step_offset;
     r.seconds += jr->seconds_offset;
     history_add(&jr->hist, &r);
+    take_frame(jr, slot->job.options.every, r.step);
     if (s->step > 0)
         atomic_fetch_add(&j->steps_total, 1);
     pthread_mutex_lock(&j->lock);
@@ -331,6 +363,7 @@ static int setup_run(tk_jobs *j, tk_job *job, job_run *jr, tk_error *err)
     free(text);
     tk_options opts;
     tk_job_options_to_run(&job->options, &opts);
+    opts.snapshot_every = 0; /* frames are taken by the worker (take_frame) */
     if (!rc && resume) {
         jr->step_offset = job->latest.step;
         jr->seconds_offset = job->latest.seconds;
@@ -345,14 +378,8 @@ static int setup_run(tk_jobs *j, tk_job *job, job_run *jr, tk_error *err)
         if (tk_store_text(j->store, job->id, TK_TEXT_HISTORY, &hist, NULL, NULL) == TK_OK)
             history_load(&jr->hist, hist, jr->step_offset);
         free(hist);
-        jr->frames_before = job->frames;
-        /* The run snapshots its start (its step 0, the job's step S), and
-         * then every `every` steps.  When S is a multiple of `every`, the
-         * frame of step S was stored with step S itself (the engine takes
-         * the snapshot before it reports the step), so the run's first
-         * snapshot would repeat it. */
-        if (opts.snapshot_every > 0 && jr->step_offset % (long)opts.snapshot_every == 0)
-            jr->frames_skip = jr->frames_flushed = 1;
+        jr->frames_stored = job->frames;
+        jr->frame_after = jr->step_offset;
     }
     if (!rc)
         rc = tk_run_new(curve, &opts, &jr->run, err);
@@ -375,6 +402,7 @@ static void run_job(worker_slot *slot)
     jr.hist.cap = j->cfg.history_limit > 2 ? j->cfg.history_limit : 2;
     jr.hist.items = malloc(jr.hist.cap * sizeof *jr.hist.items);
     jr.hist.stride = 1;
+    jr.frame_after = -1;
     if (!jr.hist.items) {
         fail_job(j, &job, "out of memory");
         return;
@@ -383,6 +411,8 @@ static void run_job(worker_slot *slot)
     if (rc) {
         fail_job(j, &job, err.message);
         free(jr.hist.items);
+        free(jr.pending_steps);
+        free(jr.pending_xyz);
         return;
     }
     job.state = TK_JOB_RUNNING;
@@ -438,6 +468,8 @@ static void run_job(worker_slot *slot)
     }
     tk_run_free(&jr.run);
     free(jr.hist.items);
+    free(jr.pending_steps);
+    free(jr.pending_xyz);
 }
 
 static void *worker_main(void *arg)

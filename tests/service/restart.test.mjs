@@ -25,7 +25,8 @@ async function assertResumedHistory(d, job, interrupted) {
         assert.ok(h.steps[i].seconds >= h.steps[i - 1].seconds, `history seconds increase at ${i}`);
 }
 
-// Frames of a resumed job: the total the job reports, steps increasing.
+// Frames of a resumed job: the total the job reports, steps increasing, on
+// the grid of options.every.
 async function assertResumedFrames(d, job) {
     const frames = [];
     for (let offset = 0; ; offset += 200) {
@@ -40,6 +41,11 @@ async function assertResumedFrames(d, job) {
     for (let i = 1; i < frames.length; i++)
         assert.ok(frames[i].step > frames[i - 1].step, `frame steps increase at ${i}: ${frames[i - 1].step}, ${frames[i].step}`);
     for (const f of frames) assert.equal(f.coordinates.length, 3 * job.vertices);
+    // on the grid of the job's steps, across the restart: every multiple of
+    // options.every up to the last step, each once
+    const every = job.options.every;
+    const want = Array.from({ length: Math.floor(job.progress.step / every) + 1 }, (_, i) => i * every);
+    assert.deepEqual(frames.map((f) => f.step), want);
 }
 
 describe('kill -9 and restart on the same store', () => {
