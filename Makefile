@@ -64,7 +64,10 @@ BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 .PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-service \
 	lint headers clean
 
-all: $(LIB) $(CLI) $(DAEMON)
+WEB_OUT := $(BUILD)/web
+WEB_SRC := $(wildcard web/*)
+
+all: $(LIB) $(CLI) $(DAEMON) $(WEB_OUT)/index.html
 
 deps:
 	$(Q)./tools/install-deps.sh
@@ -78,6 +81,11 @@ $(BUILD)/%.o: %.c
 $(LIB): $(ENGINE_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
+
+# The page: web/ and the three.js modules from node_modules (make deps).
+$(WEB_OUT)/index.html: $(WEB_SRC) tools/build-web.sh package-lock.json
+	@$(if $(Q),echo "  WEB     $(WEB_OUT)")
+	$(Q)./tools/build-web.sh $(WEB_OUT) >/dev/null
 
 $(SERVER_LIB): $(SERVER_OBJ)
 	@$(if $(Q),echo "  AR      $@")
@@ -115,7 +123,7 @@ test-unit: all $(TEST_BIN)
 # The service on its defaults: 127.0.0.1:8080, jobs in var/tightknot.db,
 # the catalogue when ../shared/catalogue is there, the page from web/.
 PORT ?= 8080
-RUN_ARGS = --port $(PORT) --db var/tightknot.db $(if $(wildcard $(CATALOGUE)/*.vect),--catalogue $(CATALOGUE)) $(if $(wildcard web/index.html),--web web)
+RUN_ARGS = --port $(PORT) --db var/tightknot.db $(if $(wildcard $(CATALOGUE)/*.vect),--catalogue $(CATALOGUE)) --web $(WEB_OUT)
 
 run: deps all
 	@mkdir -p var
