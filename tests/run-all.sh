@@ -54,10 +54,16 @@ done
 # The command-line tests (tests/cli-*.sh) and the suites in directories
 # (tests/*/run.sh: the service's API, the page in a browser) all end with
 # "NAME: N passed, M failed".
+# The service's suite runs a second time against the sanitizer build's
+# daemon and command line.
 if [ "$unit_only" -eq 0 ]; then
-    for t in tests/cli-*.sh tests/*/run.sh; do
+    suites="tests/cli-*.sh tests/*/run.sh"
+    [ -n "$asan" ] && [ -x "$asan/tightknotd" ] && suites="$suites asan:tests/service/run.sh"
+    for t in $suites; do
+        dir=$build
+        case "$t" in asan:*) dir=$asan; t=${t#asan:} ;; esac
         [ -f "$t" ] || continue
-        TK_BUILD=$build TK_DAEMON=$build/tightknotd TK_CLI=$build/tightknot TK_WEB=$build/web \
+        TK_BUILD=$dir TK_DAEMON=$dir/tightknotd TK_CLI=$dir/tightknot TK_WEB=$dir/web \
             sh "$t" >"$log" 2>&1
         line=$(grep -E '^[a-z-]+: [0-9]+ passed, [0-9]+ failed' "$log" | tail -n 1)
         if [ -z "$line" ]; then
@@ -66,7 +72,7 @@ if [ "$unit_only" -eq 0 ]; then
         p=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\1/')
         f=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\2/')
         passed=$((passed + p)); failed=$((failed + f))
-        echo "$t: $line"
+        echo "$t ($dir): $line"
         [ "$f" -eq 0 ] || grep -E '^FAIL|^not ok|^# fail|Error' "$log" | head -n 40
     done
 fi
