@@ -220,13 +220,14 @@ double tk_vertex_minrad(const double prev[3], const double v[3],
     return 0.5 * fmin(la, lb) * h;
 }
 
-/* The gradient of equation (3), the quantity whose gradient the paper
- * writes as (6): differentiate h = (|a||b| + a.b) / |a x b| = cot(theta/2)
- * with respect to the edge vectors a and b by the quotient rule, then
- * minrad = L h / 2 with L the shorter edge's length, and map edge vectors
- * back to vertices (a = v - prev, b = next - v). */
-double tk_vertex_minrad_gradient(const double prev[3], const double v[3],
-                                 const double next[3], double grad[9])
+/* The gradient of one of the two functions whose minimum is equation (3)
+ * (the paper writes the outgoing edge's as (6)): differentiate
+ * h = (|a||b| + a.b) / |a x b| = cot(theta/2) with respect to the edge
+ * vectors a and b by the quotient rule, then radius = L h / 2 with L the
+ * chosen edge's length, and map edge vectors back to vertices
+ * (a = v - prev, b = next - v). */
+double tk_vertex_radius_gradient(const double prev[3], const double v[3],
+                                 const double next[3], int edge, double grad[9])
 {
     double a[3], b[3], x[3];
     sub3(v, prev, a);
@@ -247,8 +248,8 @@ double tk_vertex_minrad_gradient(const double prev[3], const double v[3],
     if (sharp)
         den = la * lb - ab;
     double h = num / den;
-    bool a_shorter = la <= lb;
-    double len = a_shorter ? la : lb;
+    bool along_a = edge == 0;
+    double len = along_a ? la : lb;
 
     double ga[3], gb[3];
     for (int k = 0; k < 3; k++) {
@@ -261,8 +262,8 @@ double tk_vertex_minrad_gradient(const double prev[3], const double v[3],
         double dden_a = sharp ? ddiff_a : dcross_a, dden_b = sharp ? ddiff_b : dcross_b;
         double dh_a = (dnum_a * den - num * dden_a) / (den * den);
         double dh_b = (dnum_b * den - num * dden_b) / (den * den);
-        ga[k] = 0.5 * len * dh_a + (a_shorter ? 0.5 * h * a[k] / la : 0.0);
-        gb[k] = 0.5 * len * dh_b + (a_shorter ? 0.0 : 0.5 * h * b[k] / lb);
+        ga[k] = 0.5 * len * dh_a + (along_a ? 0.5 * h * a[k] / la : 0.0);
+        gb[k] = 0.5 * len * dh_b + (along_a ? 0.0 : 0.5 * h * b[k] / lb);
     }
     for (int k = 0; k < 3; k++) {
         grad[k] = -ga[k];
@@ -270,6 +271,20 @@ double tk_vertex_minrad_gradient(const double prev[3], const double v[3],
         grad[6 + k] = gb[k];
     }
     return 0.5 * len * h;
+}
+
+/* Equation (3) takes the shorter edge's function; its gradient is that
+ * function's (where the edges are equally long there is none: the flow
+ * then uses both functions as constraints). */
+double tk_vertex_minrad_gradient(const double prev[3], const double v[3],
+                                 const double next[3], double grad[9])
+{
+    double la2 = 0.0, lb2 = 0.0;
+    for (int k = 0; k < 3; k++) {
+        la2 += (v[k] - prev[k]) * (v[k] - prev[k]);
+        lb2 += (next[k] - v[k]) * (next[k] - v[k]);
+    }
+    return tk_vertex_radius_gradient(prev, v, next, sqrt(la2) <= sqrt(lb2) ? 0 : 1, grad);
 }
 
 int tk_curve_vertex_neighbours(const tk_curve *c, size_t v, size_t *prev,

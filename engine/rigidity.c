@@ -70,6 +70,14 @@ int tk_rigidity_build(const tk_curve *c, const tk_strut *struts, size_t nstruts,
                       const tk_kink *kinks, size_t nkinks, cholmod_common *cc,
                       cholmod_sparse **out, tk_error *err)
 {
+    return tk_rigidity_build_branches(c, struts, nstruts, kinks, NULL, nkinks, cc, out, err);
+}
+
+int tk_rigidity_build_branches(const tk_curve *c, const tk_strut *struts, size_t nstruts,
+                               const tk_kink *kinks, const unsigned char *kink_edge,
+                               size_t nkinks, cholmod_common *cc, cholmod_sparse **out,
+                               tk_error *err)
+{
     *out = NULL;
     size_t ncol = nstruts + nkinks;
     cholmod_sparse *a = cholmod_allocate_sparse(3 * c->nvert, ncol, 12 * ncol + 1, 1, 1, 0,
@@ -93,9 +101,14 @@ int tk_rigidity_build(const tk_curve *c, const tk_strut *struts, size_t nstruts,
             size_t v = tk_curve_vertex_index(c, kk->comp, kk->vertex), prev, next;
             tk_curve_vertex_neighbours(c, v, &prev, &next);
             double g[9];
-            /* Equation (6): the gradient of the radius at the vertex. */
-            tk_vertex_minrad_gradient(tk_curve_vertex(c, prev), tk_curve_vertex(c, v),
-                                      tk_curve_vertex(c, next), g);
+            /* Equation (6): the gradient of the radius at the vertex, of
+             * the shorter edge's function or of the one asked for. */
+            if (kink_edge)
+                tk_vertex_radius_gradient(tk_curve_vertex(c, prev), tk_curve_vertex(c, v),
+                                          tk_curve_vertex(c, next), kink_edge[j - nstruts], g);
+            else
+                tk_vertex_minrad_gradient(tk_curve_vertex(c, prev), tk_curve_vertex(c, v),
+                                          tk_curve_vertex(c, next), g);
             column_add(&col, prev, g);
             column_add(&col, v, g + 3);
             column_add(&col, next, g + 6);

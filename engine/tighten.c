@@ -36,10 +36,16 @@ struct tk_run {
     double *rhs;         /* one per constraint */
     size_t constraint_capacity;
     tk_strut_list struts;
+    /* Kink constraints: one per radius function held at a vertex (equation
+     * 3 is the minimum of one function per edge, so a vertex whose edges
+     * are about equally long carries two), kink_edge[k] saying which. */
     tk_kink *kinks;
-    size_t nkinks;
+    unsigned char *kink_edge;
+    size_t nkinks, kink_capacity;
+    tk_kink *kink_report;        /* one per vertex, forces summed */
+    size_t nkink_report;
     tk_strut_list known_struts;  /* the last resolution's, sorted, with forces */
-    tk_kink *known_kinks;
+    struct known_kink *known_kinks;
     size_t nknown_kinks;
     tk_step_report latest;
     tk_step_report *history;
@@ -54,6 +60,13 @@ struct tk_run {
     atomic_int cancel;
     tk_progress_fn progress;
     void *user;
+};
+
+/* A kink constraint's force from the last resolution, for the warm start. */
+struct known_kink {
+    size_t comp, vertex;
+    int edge;
+    double force;
 };
 
 static double now_seconds(void)
@@ -121,6 +134,8 @@ void tk_run_free(tk_run **p)
     free(r->rhs);
     tk_strut_list_free(&r->struts);
     free(r->kinks);
+    free(r->kink_edge);
+    free(r->kink_report);
     tk_strut_list_free(&r->known_struts);
     free(r->known_kinks);
     free(r->history);
@@ -196,29 +211,124 @@ static int grow_constraints(tk_run *r, size_t n, tk_error *err)
     return TK_OK;
 }
 
-/* Active constraints of the run's curve (the finder must be fitted to it). */
+/* The radius function of one edge at global vertex v of c (equation 3
+ * is the smaller of the two). */
+static double branch_radius(const tk_curve *c, size_t v, int edge)
+{
+    size_t prev, next;
+    double g[9];
+    if (!tk_curve_vertex_neighbours(c, v, &prev, &next))
+        return INFINITY;
+    return tk_vertex_radius_gradient(tk_curve_vertex(c, prev), tk_curve_vertex(c, v),
+                                     tk_curve_vertex(c, next), edge, g);
+}
+
+static int push_kink(tk_run *r, size_t comp, size_t vertex, int edge, double radius,
+                     tk_error *err)
+{
+    if (r->nkinks == r->kink_capacity) {
+        size_t cap = r->kink_capacity ? 2 * r->kink_capacity : 16;
+        tk_kink *grown = realloc(r->kinks, cap * sizeof *grown);
+        if (grown)
+            r->kinks = grown;
+        unsigned char *edges = realloc(r->kink_edge, cap * sizeof *edges);
+        if (edges)
+            r->kink_edge = edges;
+        if (!grown || !edges)
+            return tk_error_set(err, TK_ENOMEM, "out of memory for kinks");
+        r->kink_capacity = cap;
+    }
+    r->kinks[r->nkinks] = (tk_kink){comp, vertex, radius, 0.0};
+    r->kink_edge[r->nkinks] = (unsigned char)edge;
+    r->nkinks++;
+    return TK_OK;
+}
+
+static bool has_kink(const tk_run *r, size_t comp, size_t vertex, int edge)
+{
+    for (size_t i = 0; i < r->nkinks; i++)
+        if (r->kinks[i].comp == comp && r->kinks[i].vertex == vertex && r->kink_edge[i] == edge)
+            return true;
+    return false;
+}
+
+/* Active constraints of the run's curve (the finder must be fitted to it).
+ * At a kink each edge's radius function within the active tolerance is a
+ * constraint of its own.  Holding only the smaller one (equation 3's min)
+ * is not enough: the equalising motion keeps the two edges equally long,
+ * the resolved motion then keeps the one function to first order while
+ * the other falls at first order, and the step control must shrink the
+ * step in proportion to the tolerance. */
 static int find_active(tk_run *r, const tk_curve *c, tk_error *err)
 {
     tk_strut_list_clear(&r->struts);
-    free(r->kinks);
-    r->kinks = NULL;
     r->nkinks = 0;
     double slack = 1.0 + r->opt.active_tolerance;
     int rc = tk_strut_finder_find(r->finder, c, TK_ARC_ADMISSIBLE, r->tau, r->tau * slack,
                                   &r->struts, err);
+    tk_kink *found = NULL;
+    size_t nfound = 0;
     if (!rc)
-        rc = tk_kinks_find(c, 2.0 * r->min_radius * slack, &r->kinks, &r->nkinks, err);
+        rc = tk_kinks_find(c, 2.0 * r->min_radius * slack, &found, &nfound, err);
+    for (size_t k = 0; !rc && k < nfound; k++) {
+        size_t v = tk_curve_vertex_index(c, found[k].comp, found[k].vertex);
+        for (int edge = 0; edge < 2 && !rc; edge++) {
+            double radius = branch_radius(c, v, edge);
+            if (radius <= r->min_radius * slack)
+                rc = push_kink(r, found[k].comp, found[k].vertex, edge, radius, err);
+        }
+    }
+    free(found);
     if (!rc)
         rc = grow_constraints(r, r->struts.count + r->nkinks, err);
     return rc;
+}
+
+static int compare_kink_vertices(const void *pa, const void *pb)
+{
+    const tk_kink *a = pa, *b = pb;
+    if (a->comp != b->comp)
+        return a->comp < b->comp ? -1 : 1;
+    return a->vertex < b->vertex ? -1 : (a->vertex > b->vertex ? 1 : 0);
+}
+
+/* The kinks as reported: one per vertex, with its radius (equation 3) and
+ * the sum of its constraints' forces. */
+static int report_kinks(tk_run *r, tk_error *err)
+{
+    free(r->kink_report);
+    r->kink_report = NULL;
+    r->nkink_report = 0;
+    if (!r->nkinks)
+        return TK_OK;
+    tk_kink *out = malloc(r->nkinks * sizeof *out);
+    if (!out)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for kinks");
+    memcpy(out, r->kinks, r->nkinks * sizeof *out);
+    qsort(out, r->nkinks, sizeof *out, compare_kink_vertices);
+    size_t n = 0;
+    for (size_t k = 0; k < r->nkinks; k++) {
+        if (n > 0 && compare_kink_vertices(&out[n - 1], &out[k]) == 0) {
+            out[n - 1].force += out[k].force;
+            continue;
+        }
+        out[n] = out[k];
+        size_t v = tk_curve_vertex_index(r->curve, out[n].comp, out[n].vertex);
+        out[n].minrad = fmin(branch_radius(r->curve, v, 0), branch_radius(r->curve, v, 1));
+        n++;
+    }
+    r->kink_report = out;
+    r->nkink_report = n;
+    return TK_OK;
 }
 
 /* The rigidity matrix of the active constraints, with the rows of fixed
  * vertices zeroed: those coordinates are not variables. */
 static int build_matrix(tk_run *r, const tk_curve *c, cholmod_sparse **a, tk_error *err)
 {
-    int rc = tk_rigidity_build(c, r->struts.items, r->struts.count, r->kinks, r->nkinks,
-                               tk_nnls_common(r->nnls), a, err);
+    int rc = tk_rigidity_build_branches(c, r->struts.items, r->struts.count, r->kinks,
+                                        r->kink_edge, r->nkinks, tk_nnls_common(r->nnls), a,
+                                        err);
     if (rc)
         return rc;
     const int *colp = (*a)->p, *row = (*a)->i;
@@ -499,7 +609,9 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
     rep.residual = NAN;
     rep.corrections = corrections;
     rep.struts = r->struts.count;
-    rep.kinks = r->nkinks;
+    if (!rc)
+        rc = report_kinks(r, err);
+    rep.kinks = r->nkink_report;
     if (!rc)
         rc = violation(r, r->curve, &rep.violation, err);
     if (!rc)
@@ -523,12 +635,14 @@ void tk_run_cancel(tk_run *r)
     atomic_store(&r->cancel, 1);
 }
 
-static int compare_kink_vertices(const void *pa, const void *pb)
+static int compare_known_kinks(const void *pa, const void *pb)
 {
-    const tk_kink *a = pa, *b = pb;
+    const struct known_kink *a = pa, *b = pb;
     if (a->comp != b->comp)
         return a->comp < b->comp ? -1 : 1;
-    return a->vertex < b->vertex ? -1 : (a->vertex > b->vertex ? 1 : 0);
+    if (a->vertex != b->vertex)
+        return a->vertex < b->vertex ? -1 : 1;
+    return a->edge < b->edge ? -1 : (a->edge > b->edge ? 1 : 0);
 }
 
 /* The forces of the last resolution as the NNLS's starting guess: contacts
@@ -545,10 +659,11 @@ static void guess_forces(const tk_run *r)
         r->x[j] = hit ? hit->force : 0.0;
     }
     for (size_t k = 0; k < r->nkinks; k++) {
-        const tk_kink *hit = r->nknown_kinks ? bsearch(&r->kinks[k], r->known_kinks,
-                                                       r->nknown_kinks, sizeof *hit,
-                                                       compare_kink_vertices)
-                                             : NULL;
+        struct known_kink key = {r->kinks[k].comp, r->kinks[k].vertex, r->kink_edge[k], 0.0};
+        const struct known_kink *hit =
+            r->nknown_kinks ? bsearch(&key, r->known_kinks, r->nknown_kinks, sizeof *hit,
+                                      compare_known_kinks)
+                            : NULL;
         r->x[ns + k] = hit ? hit->force : 0.0;
     }
 }
@@ -576,9 +691,11 @@ static int remember_forces(tk_run *r, tk_error *err)
         r->known_kinks = malloc(r->nkinks * sizeof *r->known_kinks);
         if (!r->known_kinks)
             return tk_error_set(err, TK_ENOMEM, "out of memory for kinks");
-        memcpy(r->known_kinks, r->kinks, r->nkinks * sizeof *r->kinks);
+        for (size_t k = 0; k < r->nkinks; k++)
+            r->known_kinks[k] = (struct known_kink){r->kinks[k].comp, r->kinks[k].vertex,
+                                                    r->kink_edge[k], r->kinks[k].force};
         r->nknown_kinks = r->nkinks;
-        qsort(r->known_kinks, r->nknown_kinks, sizeof *r->known_kinks, compare_kink_vertices);
+        qsort(r->known_kinks, r->nknown_kinks, sizeof *r->known_kinks, compare_known_kinks);
     }
     return TK_OK;
 }
@@ -696,25 +813,15 @@ static int expand_active(tk_run *r, const tk_curve *trial, size_t *added, tk_err
     if (!rc)
         rc = tk_kinks_find(trial, 2.0 * r->min_radius * floor, &bent, &nbent, err);
     for (size_t k = 0; !rc && k < nbent; k++) {
-        bool known = false;
-        for (size_t i = 0; i < r->nkinks && !known; i++)
-            known = r->kinks[i].comp == bent[k].comp && r->kinks[i].vertex == bent[k].vertex;
-        if (known)
-            continue;
-        tk_kink *grown = realloc(r->kinks, (r->nkinks + 1) * sizeof *grown);
-        if (!grown) {
-            rc = tk_error_set(err, TK_ENOMEM, "out of memory for kinks");
-            break;
+        size_t v = tk_curve_vertex_index(c, bent[k].comp, bent[k].vertex);
+        for (int edge = 0; edge < 2 && !rc; edge++) {
+            if (branch_radius(trial, v, edge) > r->min_radius * floor ||
+                has_kink(r, bent[k].comp, bent[k].vertex, edge))
+                continue;
+            rc = push_kink(r, bent[k].comp, bent[k].vertex, edge, branch_radius(c, v, edge), err);
+            if (!rc)
+                (*added)++;
         }
-        r->kinks = grown;
-        size_t v = tk_curve_vertex_index(c, bent[k].comp, bent[k].vertex), prev, next;
-        tk_curve_vertex_neighbours(c, v, &prev, &next);
-        r->kinks[r->nkinks++] = (tk_kink){
-            bent[k].comp, bent[k].vertex,
-            tk_vertex_minrad(tk_curve_vertex(c, prev), tk_curve_vertex(c, v),
-                             tk_curve_vertex(c, next)),
-            0.0};
-        (*added)++;
     }
     free(bent);
     if (!rc)
@@ -845,7 +952,9 @@ int tk_run_step(tk_run *r, tk_error *err)
     if (!rc)
         rc = violation(r, r->curve, &rep.violation, err);
     rep.struts = r->struts.count;
-    rep.kinks = r->nkinks;
+    if (!rc)
+        rc = report_kinks(r, err);
+    rep.kinks = r->nkink_report;
     if (!rc)
         rc = record(r, &rep, err);
     if (rc) {
@@ -904,8 +1013,8 @@ const tk_strut *tk_run_struts(const tk_run *r, size_t *count)
 
 const tk_kink *tk_run_kinks(const tk_run *r, size_t *count)
 {
-    *count = r->nkinks;
-    return r->kinks;
+    *count = r->nkink_report;
+    return r->kink_report;
 }
 
 tk_stop_reason tk_run_stop_reason(const tk_run *r)

@@ -115,6 +115,29 @@ START_TEST(hopf_link_tightens_towards_8_pi)
 }
 END_TEST
 
+START_TEST(generated_chain_of_three_tightens_to_12_pi_plus_4)
+{
+    if (quick())
+        return;
+    /* The tight chain of three: the end rings round (ropelength 4 pi
+     * each), the middle one a stadium of two semicircles of diameter 2
+     * joined by straight pieces of length 1 (4 pi + 4).  The end rings
+     * pull kinks into themselves where they hook the middle ring before
+     * they round out, so this exercises the kink constraints. */
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_chain(3, 0, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 4;
+    o.max_steps = 3500;
+    double rope = tighten(c, &o, "chain of 3", NULL);
+    double tight = 12 * M_PI + 4;
+    ck_assert_msg(fabs(rope - tight) < 1e-3 * tight, "ropelength %.6f vs 12 pi + 4 = %.6f",
+                  rope, tight);
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(catalogue_trefoil_at_resolution_5)
 {
     if (quick() || !tkt_catalogue_dir()) {
@@ -351,6 +374,7 @@ int main(void)
     tcase_add_test(tc, hopf_link_tightens_towards_8_pi);
     tcase_add_test(tc, generated_hopf_link_tightens_to_8_pi);
     tcase_add_test(tc, catalogue_trefoil_at_resolution_5);
+    tcase_add_test(tc, generated_chain_of_three_tightens_to_12_pi_plus_4);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);
 }

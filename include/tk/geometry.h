@@ -53,6 +53,14 @@ double tk_vertex_minrad(const double prev[3], const double v[3],
 double tk_vertex_minrad_gradient(const double prev[3], const double v[3],
                                  const double next[3], double grad[9]);
 
+/* Equation (3) is the minimum of two smooth functions, one per edge:
+ *     |e| / (2 tan(theta / 2)),  e = v - prev (edge 0) or next - v (edge 1).
+ * Returns the chosen one's value and its gradient with respect to
+ * (prev, v, next) (equation 6 for edge 1); +INFINITY and a zero gradient
+ * at a straight vertex. */
+double tk_vertex_radius_gradient(const double prev[3], const double v[3],
+                                 const double next[3], int edge, double grad[9]);
+
 /* Turning angle at v in [0, pi]. */
 double tk_vertex_turning(const double prev[3], const double v[3],
                          const double next[3]);

@@ -24,6 +24,16 @@ int tk_rigidity_build(const tk_curve *c, const tk_strut *struts, size_t nstruts,
                       const tk_kink *kinks, size_t nkinks, cholmod_common *cc,
                       cholmod_sparse **out, tk_error *err);
 
+/* The same with a choice of function per kink: kink_edge[k] = 0 or 1 makes
+ * kink k's column the gradient of that edge's radius function (see
+ * tk_vertex_radius_gradient), so that a vertex whose two edges are equally
+ * long can carry both functions as constraints; kink_edge NULL is
+ * tk_rigidity_build. */
+int tk_rigidity_build_branches(const tk_curve *c, const tk_strut *struts, size_t nstruts,
+                               const tk_kink *kinks, const unsigned char *kink_edge,
+                               size_t nkinks, cholmod_common *cc, cholmod_sparse **out,
+                               tk_error *err);
+
 /* The global vertex indices a strut's gradient touches (head and tail of
  * each edge) and the 12 gradient entries (equation 7), recomputed from the
  * curve at the strut's parameters. */

@@ -5,7 +5,9 @@
  * threads share nothing.  Each step:
  *   1. active constraints: struts within tau (1 + active_tolerance) among
  *      Theorem 3's admissible pairs, and kinks (vertices whose minrad is
- *      within the same tolerance of lambda * radius);
+ *      within the same tolerance of lambda * radius; equation 3 is the
+ *      smaller of one function per edge, and each of the two within the
+ *      tolerance is a constraint);
  *   2. the motion u = -grad(length) (equation 14) plus a tangential motion
  *      that evens out the edges (section 4.2);
  *   3. the rigidity matrix A (equations 6, 7) and the NNLS problem
