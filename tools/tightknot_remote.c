@@ -333,11 +333,13 @@ static item *find_item(item *items, size_t n, const char *name)
 static const char summary_header[] =
     "name\tcomponents\tvertices\tropelength\tthickness\tresidual\tstruts\tsteps\tseconds\tstate\n";
 
-/* Reads an earlier summary: rows of files that are done are kept. */
-static void load_summary(const char *out, item *items, size_t n)
+/* Calls take(line, item) for every line of DIR/file whose first field
+ * names one of the items (a missing file has no lines). */
+static void each_row(const char *out, const char *file, item *items, size_t n,
+                     void (*take)(char *line, item *it))
 {
     char path[4096];
-    if (!join_path(path, sizeof path, out, "summary.tsv"))
+    if (!join_path(path, sizeof path, out, file))
         return;
     size_t len = 0;
     char *text = read_file(path, &len);
@@ -346,45 +348,36 @@ static void load_summary(const char *out, item *items, size_t n)
     char *save = NULL;
     for (char *line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
         const char *tab = strchr(line, '\t');
-        const char *state = strrchr(line, '\t');
-        if (!tab || !state || strncmp(line, "name\t", 5) == 0)
+        if (!tab)
             continue;
         char name[1024];
         snprintf(name, sizeof name, "%.*s", (int)(tab - line), line);
         item *it = find_item(items, n, name);
-        if (it && !strcmp(state + 1, "done")) {
-            size_t rowlen = strlen(line) + 2;
-            it->row = malloc(rowlen);
-            if (it->row)
-                snprintf(it->row, rowlen, "%s\n", line);
-            it->phase = ITEM_FINISHED;
-            snprintf(it->state, sizeof it->state, "done");
-        }
+        if (it)
+            take(line, it);
     }
     free(text);
 }
 
-/* Reads the job ids of earlier submissions (name TAB id per line). */
-static void load_jobs(const char *out, item *items, size_t n)
+/* A row of an earlier summary: kept when its file is done. */
+static void take_summary_row(char *line, item *it)
 {
-    char path[4096];
-    if (!join_path(path, sizeof path, out, "jobs.tsv"))
+    const char *state = strrchr(line, '\t');
+    if (strcmp(state + 1, "done") != 0)
         return;
-    size_t len = 0;
-    char *text = read_file(path, &len);
-    if (!text)
-        return;
-    char *save = NULL;
-    for (char *line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
-        char *tab = strchr(line, '\t');
-        if (!tab)
-            continue;
-        *tab = '\0';
-        item *it = find_item(items, n, line);
-        if (it && it->phase == ITEM_WAITING)
-            it->job = strtoll(tab + 1, NULL, 10);
-    }
-    free(text);
+    size_t rowlen = strlen(line) + 2;
+    it->row = malloc(rowlen);
+    if (it->row)
+        snprintf(it->row, rowlen, "%s\n", line);
+    it->phase = ITEM_FINISHED;
+    snprintf(it->state, sizeof it->state, "done");
+}
+
+/* A row of jobs.tsv (name TAB id): the job of an earlier submission. */
+static void take_job_row(char *line, item *it)
+{
+    if (it->phase == ITEM_WAITING)
+        it->job = strtoll(strchr(line, '\t') + 1, NULL, 10);
 }
 
 static bool append_job(const char *out, const item *it)
@@ -621,8 +614,8 @@ static int cmd_submit(client *c, const run_args *a, int argc, char **argv)
         fprintf(stderr, "tightknot remote: cannot make %s: %s\n", a->out, strerror(errno));
         return REMOTE_FAILED;
     }
-    load_summary(a->out, items, n);
-    load_jobs(a->out, items, n);
+    each_row(a->out, "summary.tsv", items, n, take_summary_row);
+    each_row(a->out, "jobs.tsv", items, n, take_job_row);
     /* jobs submitted by an earlier run are followed, not submitted again */
     size_t running = 0;
     for (size_t i = 0; i < n; i++)
