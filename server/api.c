@@ -31,6 +31,9 @@
 #define FRAMES_LIMIT_DEFAULT 20
 #define FRAMES_LIMIT_MAX 200
 #define HISTORY_LIMIT_MAX 2000
+/* A page of frames holds at most this many coordinates (about 25 MB of
+ * JSON), however many vertices the job has. */
+#define FRAMES_COORDINATES_MAX 1000000
 
 enum { CLASS_2XX, CLASS_3XX, CLASS_4XX, CLASS_5XX, CLASSES };
 
@@ -479,6 +482,10 @@ static mhd_result get_job_frames(tk_api *a, struct MHD_Connection *c, const tk_j
     if (!query_count(a, c, "offset", 0, 0, LONG_MAX, &offset, &ret) ||
         !query_count(a, c, "limit", FRAMES_LIMIT_DEFAULT, 1, FRAMES_LIMIT_MAX, &limit, &ret))
         return ret;
+    size_t per_frame = 3 * job->latest.vertices;
+    if (per_frame > 0 && (size_t)limit * per_frame > FRAMES_COORDINATES_MAX)
+        limit = (long)(FRAMES_COORDINATES_MAX / per_frame > 0 ? FRAMES_COORDINATES_MAX / per_frame
+                                                               : 1);
     long *steps = NULL;
     double *xyz = NULL;
     size_t n = 0, per = 0;
