@@ -249,9 +249,9 @@ static double job_fraction(const tk_job *job)
     return f < 0.0 ? -1.0 : fmin(f, 1.0);
 }
 
-/* Writes the job's figures, curve, history and new frames to the store;
- * contacts too when final. */
-static int flush_job(job_run *jr, const tk_job *job, bool final, tk_error *err)
+/* Writes the job's figures, curve, contacts, history and new frames to the
+ * store, in one transaction: a restart finds them consistent. */
+static int flush_job(job_run *jr, const tk_job *job, tk_error *err)
 {
     char *curve = NULL, *contacts = NULL, *hist = NULL;
     int rc = tk_vect_to_string(tk_run_curve(jr->run), &curve, NULL, err);
@@ -291,7 +291,6 @@ static int flush_job(job_run *jr, const tk_job *job, bool final, tk_error *err)
             jr->pending = 0;
         }
     }
-    (void)final;
     free(frames);
     free(curve);
     free(contacts);
@@ -324,7 +323,7 @@ static int on_step(const tk_step_report *s, void *user)
         jr->last_flush = now;
         /* a failed periodic write is retried at the next one; the final
          * write reports it */
-        if (flush_job(jr, &copy, false, &jr->flush_error) == TK_OK)
+        if (flush_job(jr, &copy, &jr->flush_error) == TK_OK)
             tk_error_clear(&jr->flush_error);
     }
     return stop;
@@ -426,13 +425,14 @@ static void run_job(worker_slot *slot)
         tk_run_cancel(jr.run);
     pthread_mutex_unlock(&j->lock);
 
-    /* the start's figures (step 0, or the step it resumes from) */
+    /* the start's figures (step 0, or the step it resumes from), stored
+     * at once: a crash from here on resumes from this curve */
+    jr.last_flush = now_monotonic();
     on_step(tk_run_latest(jr.run), &jr);
     pthread_mutex_lock(&j->lock);
     job = slot->job;
     pthread_mutex_unlock(&j->lock);
-    jr.last_flush = now_monotonic();
-    flush_job(&jr, &job, false, &err);
+    flush_job(&jr, &job, &err);
 
     tk_run_set_progress(jr.run, on_step, &jr);
     tk_stop_reason why = TK_STOP_NONE;
@@ -461,7 +461,7 @@ static void run_job(worker_slot *slot)
     if (tk_job_state_final(job.state))
         job.finished = now_unix();
     tk_error werr;
-    if (flush_job(&jr, &job, true, &werr) != TK_OK) {
+    if (flush_job(&jr, &job, &werr) != TK_OK) {
         job.state = TK_JOB_FAILED;
         snprintf(job.error, sizeof job.error, "storing the result failed: %.280s", werr.message);
         tk_store_update(j->store, &job, NULL);
