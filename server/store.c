@@ -15,6 +15,7 @@
 struct tk_store {
     sqlite3 *db;
     pthread_mutex_t lock;
+    sqlite3_stmt *get;    /* the reads of every poll, prepared once */
 };
 
 static const char *const state_names[TK_JOB_STATES] = {"queued", "running", "done", "failed",
@@ -112,6 +113,7 @@ void tk_store_close(tk_store **p)
 {
     if (!p || !*p)
         return;
+    sqlite3_finalize((*p)->get);
     sqlite3_close_v2((*p)->db);
     pthread_mutex_destroy(&(*p)->lock);
     free(*p);
@@ -222,9 +224,11 @@ static void read_job(sqlite3_stmt *st, tk_job *j)
 int tk_store_get(tk_store *s, int64_t id, tk_job *out, tk_error *err)
 {
     pthread_mutex_lock(&s->lock);
-    sqlite3_stmt *st = NULL;
-    int rc = sqlite3_prepare_v2(s->db, "SELECT " JOB_COLUMNS " FROM jobs WHERE id = ?", -1, &st,
-                                NULL);
+    int rc = SQLITE_OK;
+    if (!s->get)
+        rc = sqlite3_prepare_v3(s->db, "SELECT " JOB_COLUMNS " FROM jobs WHERE id = ?", -1,
+                                SQLITE_PREPARE_PERSISTENT, &s->get, NULL);
+    sqlite3_stmt *st = s->get;
     int status = TK_OK;
     if (rc == SQLITE_OK) {
         sqlite3_bind_int64(st, 1, id);
@@ -236,7 +240,8 @@ int tk_store_get(tk_store *s, int64_t id, tk_job *out, tk_error *err)
         status = tk_error_set(err, TK_ENOTFOUND, "there is no job %lld", (long long)id);
     else
         status = db_error(s, err, "reading a job");
-    sqlite3_finalize(st);
+    if (st)
+        sqlite3_reset(st);
     pthread_mutex_unlock(&s->lock);
     return status;
 }
