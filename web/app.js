@@ -3,7 +3,7 @@
 import { api, ApiError, TERMINAL } from './api.js';
 import { parseVect, splitFlat, torusLink, scaleToFit, writeVect } from './geometry.js';
 import { drawHistory, drawContactMap, fmtForce } from './charts.js';
-import { View3D, forceColour, rampCss } from './view3d.js';
+import { createView, forceColour, rampCss } from './view3d.js';
 
 const $ = (id) => document.getElementById(id);
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
@@ -321,7 +321,7 @@ async function cancelJob() {
 function selectJob(id) {
     id = Number(id);
     if (!view) {
-        view = new View3D($('view3d'));
+        view = createView($('view3d'));
         view.setOpacity(Number($('tube-opacity').value));
     }
     stopPlay();

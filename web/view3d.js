@@ -20,11 +20,49 @@ export function forceColour(f) {
 }
 export const rampCss = `linear-gradient(to right, ${RAMP.join(', ')})`;
 
+// The view for the container: the 3-D one, or where the browser offers no
+// WebGL 2 (blocked, switched off, no usable driver) a stand-in that says so
+// and leaves the rest of the page working.
+export function createView(container) {
+    const canvas = document.createElement('canvas');
+    let why = '';
+    canvas.addEventListener('webglcontextcreationerror', (e) => { why = e.statusMessage || ''; });
+    // preserveDrawingBuffer lets the picture be read back (tests, saving).
+    const gl = canvas.getContext('webgl2', {
+        alpha: true, depth: true, stencil: false, antialias: true,
+        premultipliedAlpha: true, preserveDrawingBuffer: true,
+    });
+    return gl ? new View3D(container, canvas, gl) : new NoView3D(container, why);
+}
+
+export class NoView3D {
+    constructor(container, why) {
+        this.unavailable = true;
+        const p = document.createElement('p');
+        p.className = 'view3d-message';
+        p.setAttribute('role', 'status');
+        p.textContent = 'No 3-D view: this browser does not provide WebGL 2, which the view needs. ' +
+            'The figures, tables, chart and contact map work without it.';
+        if (why) p.title = why.trim();
+        container.append(p);
+    }
+
+    render() {}
+    renderNow() {}
+    setOpacity() {}
+    setShowStruts() {}
+    clear() {}
+    setCurve() {}
+    setStruts() {}
+    highlight() {}
+    clearHighlight() {}
+    fit() {}
+}
+
 export class View3D {
-    constructor(container) {
+    constructor(container, canvas, context) {
         this.container = container;
-        // preserveDrawingBuffer lets the picture be read back (tests, saving).
-        this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+        this.renderer = new THREE.WebGLRenderer({ canvas, context, antialias: true, preserveDrawingBuffer: true });
         this.renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
         this.renderer.setClearColor(BACKGROUND, 1);
         container.appendChild(this.renderer.domElement);
