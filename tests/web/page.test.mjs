@@ -12,52 +12,19 @@
 
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
-import { mkdtempSync, mkdirSync, readFileSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { dirname, join, resolve } from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { mkdirSync, readFileSync } from 'node:fs';
+import { join } from 'node:path';
 import { chromium } from 'playwright-core';
+import { ARTIFACTS, sleep, startDaemon, api as daemonApi } from './daemon.mjs';
 
-const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), '..', '..');
-const fromEnv = (name, dflt) =>
-    process.env[name] ? resolve(process.cwd(), process.env[name]) : resolve(ROOT, dflt);
-const DAEMON = fromEnv('TK_DAEMON', 'build/tightknotd');
-const CATALOGUE = fromEnv('TK_CATALOGUE', '../shared/catalogue');
-const WEB = fromEnv('TK_WEB', 'build/web');
 const CHROMIUM = process.env.TK_CHROMIUM || '/usr/bin/chromium';
-const ARTIFACTS = join(ROOT, 'test-artifacts', 'web');
 
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-
-let daemon, base, browser, page, tmp;
+let daemon, base, browser, page;
 const pageErrors = [];
 const consoleErrors = [];
 const shared = {};  // what one test leaves for the next
 
-async function startDaemon() {
-    tmp = mkdtempSync(join(tmpdir(), 'tk-web-'));
-    const args = ['--port', '0', '--db', join(tmp, 'jobs.db'), '--catalogue', CATALOGUE, '--web', WEB, '--workers', '2'];
-    daemon = spawn(DAEMON, args, { stdio: ['ignore', 'pipe', 'pipe'] });
-    let stderr = '';
-    daemon.stderr.on('data', (d) => { stderr += d; });
-    return new Promise((resolveUrl, reject) => {
-        let out = '';
-        const timer = setTimeout(() => reject(new Error(`the daemon did not start: ${stderr}`)), 15000);
-        daemon.stdout.on('data', (d) => {
-            out += d;
-            const m = /(http:\/\/[^\s/]+)/.exec(out.split('\n')[0] || '');
-            if (m && out.includes('\n')) { clearTimeout(timer); resolveUrl(m[1]); }
-        });
-        daemon.on('exit', (code) => { clearTimeout(timer); reject(new Error(`the daemon exited (${code}): ${stderr}`)); });
-    });
-}
-
-async function api(path, init) {
-    const res = await fetch(base + path, init);
-    const body = (res.headers.get('content-type') || '').includes('json') ? await res.json() : await res.text();
-    return { status: res.status, body };
-}
+const api = (path, init) => daemonApi(base, path, init);
 
 // Reads the 3-D canvas back: the share of pixels that differ from the
 // background, the number of distinct colours (quantised), and a coarse
@@ -125,7 +92,8 @@ async function setOptions(o) {
 
 before(async () => {
     mkdirSync(ARTIFACTS, { recursive: true });
-    base = await startDaemon();
+    daemon = await startDaemon();
+    base = daemon.base;
     browser = await chromium.launch({
         executablePath: CHROMIUM,
         headless: true,
@@ -140,13 +108,7 @@ before(async () => {
 
 after(async () => {
     await browser?.close();
-    if (daemon && daemon.exitCode === null) {
-        const gone = new Promise((r) => daemon.on('exit', r));
-        daemon.kill('SIGTERM');
-        await Promise.race([gone, sleep(10000)]);
-        if (daemon.exitCode === null) daemon.kill('SIGKILL');
-    }
-    if (tmp) rmSync(tmp, { recursive: true, force: true });
+    await daemon?.stop();
 });
 
 test('the page and its libraries come from the daemon, with the catalogue', async () => {
