@@ -1,0 +1,240 @@
+// The page in headless Firefox against the real daemon: the catalogue,
+// a knot submitted through the form and tightened, its struts in the table,
+// on the contact map and in the 3-D view, the message for a bad VECT, and
+// the page without WebGL.
+//
+// Firefox decides whether it may use WebGL by probing the X server's GL
+// driver at startup, even when headless; without a display it offers no
+// WebGL at all.  So a private Xvfb is started for that probe (Mesa's
+// software renderer then draws), and Firefox still runs headless.
+//
+// Environment: TK_DAEMON, TK_CATALOGUE, TK_WEB as in daemon.mjs, and
+//   TK_FIREFOX  the browser (default /usr/bin/firefox-esr)
+//   TK_XVFB     the X server for the probe (default /usr/bin/Xvfb)
+// Screenshots go to test-artifacts/web/firefox-*.png.
+
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import { mkdirSync } from 'node:fs';
+import { join } from 'node:path';
+import puppeteer from 'puppeteer-core';
+import { ARTIFACTS, sleep, startDaemon, api as daemonApi } from './daemon.mjs';
+
+const FIREFOX = process.env.TK_FIREFOX || '/usr/bin/firefox-esr';
+const XVFB = process.env.TK_XVFB || '/usr/bin/Xvfb';
+
+let daemon, base, xvfb, browser, page;
+const pageErrors = [];
+const consoleErrors = [];
+const shared = {};  // what one test leaves for the next
+
+const api = (path, init) => daemonApi(base, path, init);
+
+// Starts Xvfb on a display number it picks itself; resolves to ":N".
+function startXvfb() {
+    xvfb = spawn(XVFB, ['-displayfd', '3', '-screen', '0', '1400x900x24', '-nolisten', 'tcp'],
+        { stdio: ['ignore', 'ignore', 'pipe', 'pipe'] });
+    let stderr = '';
+    xvfb.stderr.on('data', (d) => { stderr += d; });
+    return new Promise((resolveDisplay, reject) => {
+        let out = '';
+        const timer = setTimeout(() => reject(new Error(`Xvfb did not start: ${stderr}`)), 15000);
+        xvfb.stdio[3].on('data', (d) => {
+            out += d;
+            if (out.includes('\n')) { clearTimeout(timer); resolveDisplay(`:${out.trim()}`); }
+        });
+        xvfb.on('error', (e) => { clearTimeout(timer); reject(e); });
+        xvfb.on('exit', (code) => { clearTimeout(timer); reject(new Error(`Xvfb exited (${code}): ${stderr}`)); });
+    });
+}
+
+async function stopXvfb() {
+    if (!xvfb || xvfb.exitCode !== null || xvfb.signalCode !== null) return;
+    const gone = new Promise((r) => xvfb.on('exit', r));
+    xvfb.kill('SIGTERM');
+    await Promise.race([gone, sleep(5000)]);
+    if (xvfb.exitCode === null && xvfb.signalCode === null) xvfb.kill('SIGKILL');
+}
+
+function watchErrors(p) {
+    p.on('pageerror', (e) => pageErrors.push(String(e?.message ?? e)));
+    p.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+}
+
+// The share of the 3-D canvas that differs from the background, and the
+// number of distinct colours (quantised), as page.test.mjs reads them.
+async function canvasPixels() {
+    return page.evaluate(() => {
+        window.tightknot.view.renderNow();
+        const src = document.querySelector('#view3d canvas');
+        const w = src.width, h = src.height;
+        const c = document.createElement('canvas');
+        c.width = w; c.height = h;
+        const g = c.getContext('2d', { willReadFrequently: true });
+        g.drawImage(src, 0, 0);
+        const d = g.getImageData(0, 0, w, h).data;
+        const bg = [d[0], d[1], d[2]];
+        let other = 0;
+        const colours = new Set();
+        for (let i = 0; i < d.length; i += 4) {
+            if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 12) other++;
+            colours.add(((d[i] >> 3) << 10) | ((d[i + 1] >> 3) << 5) | (d[i + 2] >> 3));
+        }
+        return { w, h, share: other / (w * h), colours: colours.size };
+    });
+}
+
+const count = (sel) => page.$$eval(sel, (els) => els.length);
+const text = (sel) => page.$eval(sel, (el) => el.textContent);
+
+async function fill(sel, value) {
+    await page.locator(sel).fill(String(value));
+}
+
+before(async () => {
+    mkdirSync(ARTIFACTS, { recursive: true });
+    const display = await startXvfb();
+    daemon = await startDaemon();
+    base = daemon.base;
+    browser = await puppeteer.launch({
+        browser: 'firefox',
+        executablePath: FIREFOX,
+        headless: true,
+        env: { ...process.env, DISPLAY: display },
+        defaultViewport: { width: 1366, height: 768 },
+        protocolTimeout: 120000,
+    });
+    page = await browser.newPage();
+    watchErrors(page);
+    page.setDefaultTimeout(30000);
+});
+
+after(async () => {
+    await browser?.close();
+    await daemon?.stop();
+    await stopXvfb();
+});
+
+test('Firefox: the page loads with the whole catalogue and WebGL 2', async () => {
+    await page.goto(base + '/');
+    const { body: cat } = await api('/v1/catalogue');
+    assert.ok(cat.count > 0);
+    await page.waitForFunction((n) => document.querySelectorAll('#catalogue-select option').length === n, {}, cat.count);
+    assert.equal(await page.title(), 'tightknot');
+    const version = await browser.version();
+    assert.match(version, /firefox/i);
+    const gl = await page.evaluate(() => Boolean(document.createElement('canvas').getContext('webgl2')));
+    assert.ok(gl, `${version} offers WebGL 2`);
+});
+
+test('Firefox: a catalogue knot submitted through the form is tightened and shown', async () => {
+    await page.click('#tab-catalogue');
+    await fill('#catalogue-filter', '3.1');
+    await page.select('#catalogue-select', '3.1');
+    await fill('#opt-resolution', 5);
+    await fill('#opt-steps', 200);
+    await fill('#opt-every', 10);
+    await fill('#opt-time', 0);
+    await fill('#opt-residual', 0);
+    await page.click('#submit-button');
+    await page.waitForFunction(() => {
+        const m = document.getElementById('submit-message');
+        return !m.hidden && (m.classList.contains('error') || m.dataset.job);
+    });
+    assert.equal(await count('#submit-message.error'), 0, `the page reports: ${await text('#submit-message')}`);
+    const id = Number(await page.$eval('#submit-message', (m) => m.dataset.job));
+    shared.trefoil = id;
+    await page.waitForSelector('#job-state[data-state="done"]', { timeout: 120000 });
+    await page.waitForSelector('#job[data-phase="final"]');
+    await sleep(300);
+    await page.screenshot({ path: join(ARTIFACTS, 'firefox-done.png'), fullPage: true });
+
+    const { body: job } = await api(`/v1/jobs/${id}`);
+    const { body: contacts } = await api(`/v1/jobs/${id}/struts`);
+    assert.equal(job.state, 'done');
+    assert.equal(job.name, '3.1');
+    assert.equal(job.options.steps, 200);
+    assert.equal(job.options.every, 10);
+    assert.ok(contacts.struts.length > 0, 'a tightened trefoil has struts');
+    assert.equal(await count('#strut-table tbody tr'), contacts.struts.length, 'one table row per strut');
+    assert.equal(await count('#contact-map .strut-mark'), contacts.struts.length, 'one contact-map mark per strut');
+    assert.equal(await count('#contact-map .kink-mark'), contacts.kinks.length, 'one mark per kink');
+    assert.equal(await text('#fig-struts'), String(job.struts));
+    assert.equal(await text('#fig-ropelength'), job.ropelength.toFixed(3));
+    const d = await page.$eval('#chart path.curve', (p) => p.getAttribute('d'));
+    assert.ok((d.match(/L/g) || []).length >= 2, 'the chart draws the history');
+
+    assert.equal(await count('#view3d .view3d-message'), 0, 'no message in place of the 3-D view');
+    const px = await canvasPixels();
+    assert.ok(px.w > 300 && px.h > 200, `the canvas is ${px.w}x${px.h}`);
+    assert.ok(px.share > 0.03, `the 3-D view is not blank (${(100 * px.share).toFixed(1)}% drawn)`);
+    assert.ok(px.colours > 20, `the tube is shaded (${px.colours} colours)`);
+    shared.finalPixels = px;
+});
+
+test('Firefox: hovering a strut row marks that strut on the map', async () => {
+    const index = await page.$eval('#strut-table tbody tr', (r) => r.dataset.index);
+    await page.hover('#strut-table tbody tr');
+    await page.waitForSelector(`#contact-map .strut-mark.hot[data-index="${index}"]`);
+    await page.hover('#job-name');
+    await page.waitForFunction(() => !document.querySelector('#contact-map .strut-mark.hot'));
+});
+
+test('Firefox: a bad VECT is rejected with the problem\'s detail and line', async () => {
+    const bad = 'VECT\n1 4 0\n-4\n0\n0 0 0\n4 0 0\nfoo 4 0\n0 4 0\n';
+    const direct = await api('/v1/jobs', {
+        method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ vect: bad }),
+    });
+    assert.equal(direct.status, 422);
+    assert.equal(direct.body.line, 7);
+    const totalBefore = (await api('/v1/jobs?limit=1')).body.total;
+
+    await page.click('#tab-vect');
+    await fill('#vect-text', bad);
+    assert.equal(await page.$eval('#vect-text', (t) => t.value), bad, 'the textarea holds the pasted text');
+    await page.click('#submit-button');
+    await page.waitForSelector('#submit-message.error');
+    const message = await text('#submit-message.error');
+    assert.ok(message.includes(direct.body.detail), `the message shows the detail: ${message}`);
+    assert.match(message, /line 7\b/);
+    assert.equal(await page.$eval('#submit-message.error .where', (w) => w.dataset.line), '7');
+    const sel = await page.$eval('#vect-text', (t) => t.value.slice(t.selectionStart, t.selectionEnd));
+    assert.equal(sel, 'foo 4 0', 'the bad line is selected');
+    assert.equal((await api('/v1/jobs?limit=1')).body.total, totalBefore, 'no job was stored');
+    await page.screenshot({ path: join(ARTIFACTS, 'firefox-bad-vect.png') });
+});
+
+test('Firefox: without WebGL the page says so and shows the rest', async () => {
+    const id = shared.trefoil;
+    assert.ok(id, 'the trefoil of the earlier test');
+    const plain = await browser.newPage();
+    watchErrors(plain);
+    try {
+        // As a browser with WebGL switched off: no context of either kind.
+        await plain.evaluateOnNewDocument(() => {
+            const getContext = HTMLCanvasElement.prototype.getContext;
+            HTMLCanvasElement.prototype.getContext = function (kind, ...rest) {
+                return /^(webgl|webgl2|experimental-webgl)$/.test(kind) ? null : getContext.call(this, kind, ...rest);
+            };
+        });
+        await plain.goto(`${base}/#job=${id}`);
+        await plain.waitForSelector('#job[data-phase="final"]', { timeout: 30000 });
+        const message = await plain.$eval('#view3d .view3d-message', (m) => m.textContent);
+        assert.match(message, /WebGL/);
+        assert.equal(await plain.$$eval('#view3d canvas', (c) => c.length), 0, 'no canvas');
+        const { body: contacts } = await api(`/v1/jobs/${id}/struts`);
+        assert.equal(await plain.$$eval('#strut-table tbody tr', (r) => r.length), contacts.struts.length);
+        assert.equal(await plain.$$eval('#contact-map .strut-mark', (m) => m.length), contacts.struts.length);
+        await plain.hover('#strut-table tbody tr');
+        await plain.waitForSelector('#contact-map .strut-mark.hot');
+        await plain.screenshot({ path: join(ARTIFACTS, 'firefox-no-webgl.png') });
+    } finally {
+        await plain.close();
+    }
+});
+
+test('Firefox: no script errors', () => {
+    assert.deepEqual(pageErrors, []);
+    assert.deepEqual(consoleErrors.filter((e) => !/status of 4\d\d/.test(e)), []);
+});
