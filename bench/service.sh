@@ -17,7 +17,17 @@ window=${WINDOW:-10}
 knot=${KNOT:-10.1}
 command -v wrk >/dev/null || { echo "bench/service: wrk is not installed (make deps)"; exit 1; }
 dir=$(mktemp -d)
-trap 'kill "$pid" 2>/dev/null; wait "$pid" 2>/dev/null; rm -rf "$dir"' EXIT INT TERM
+stop_daemon() {
+    kill "$pid" 2>/dev/null || return 0
+    for _ in $(seq 100); do
+        kill -0 "$pid" 2>/dev/null || return 0
+        sleep 0.1
+    done
+    echo "bench/service: the daemon did not stop within 10 s of SIGTERM; killing it"
+    kill -9 "$pid" 2>/dev/null
+}
+trap 'stop_daemon; rm -rf "$dir"' EXIT
+trap 'exit 1' INT TERM
 "$build/tightknotd" --port 0 --db "$dir/bench.db" --catalogue "$catalogue" >"$dir/log" 2>&1 &
 pid=$!
 port=""

@@ -148,6 +148,11 @@ int main(int argc, char **argv)
     /* The signals are taken by sigwait below, never by a handler, so every
      * thread started from here on blocks them. */
     sigset_t stop_signals;
+    /* A shell that starts a program in the background makes it ignore
+     * SIGINT, and an ignored signal never reaches sigwait: take both back
+     * to their defaults first. */
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
     sigemptyset(&stop_signals);
     sigaddset(&stop_signals, SIGINT);
     sigaddset(&stop_signals, SIGTERM);
