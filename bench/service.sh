@@ -17,6 +17,10 @@ window=${WINDOW:-10}
 knot=${KNOT:-10.1}
 command -v wrk >/dev/null || { echo "bench/service: wrk is not installed (make deps)"; exit 1; }
 dir=$(mktemp -d)
+: >"$dir/log"
+"$build/tightknotd" --port 0 --db "$dir/bench.db" --catalogue "$catalogue" >"$dir/log" 2>&1 &
+pid=$!
+# the traps are set once the daemon runs, so that it never sees them
 stop_daemon() {
     kill "$pid" 2>/dev/null || return 0
     for _ in $(seq 100); do
@@ -28,11 +32,9 @@ stop_daemon() {
 }
 trap 'stop_daemon; rm -rf "$dir"' EXIT
 trap 'exit 1' INT TERM
-"$build/tightknotd" --port 0 --db "$dir/bench.db" --catalogue "$catalogue" >"$dir/log" 2>&1 &
-pid=$!
 port=""
 for _ in $(seq 50); do
-    port=$(sed -n 's|.*http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$dir/log")
+    port=$(sed -n 's|.*http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$dir/log" || true)
     [ -n "$port" ] && break
     sleep 0.1
 done
