@@ -355,16 +355,24 @@ static size_t edges_at(const tk_strut_finder *f, size_t e, double s, size_t out[
     return 1;
 }
 
+/* What edge pair (i, j) is to its closest points `cl`. */
+typedef enum contact_role {
+    CONTACT_OWNER,       /* a local minimum of the self-distance, reported
+                            by this pair */
+    CONTACT_DUPLICATE,   /* the same local minimum, reported by another pair */
+    CONTACT_NOT_MINIMUM  /* an edge pair through p and q comes closer */
+} contact_role;
+
 /* Decides whether edge pair (i, j) reports contact `cl`: it must be a local
  * minimum of the self-distance (no edge pair through p and q comes closer)
  * and (i, j) must be its owner.  See the comment at the top. */
-static bool owns_contact(const tk_strut_finder *f, const tk_curve *c, size_t i,
-                         size_t j, const tk_closest *cl)
+static contact_role contact_role_of(const tk_strut_finder *f, const tk_curve *c, size_t i,
+                                    size_t j, const tk_closest *cl)
 {
     size_t pe[2], qe[2];
     size_t np = edges_at(f, i, cl->s, pe), nq = edges_at(f, j, cl->t, qe);
     if (np == 1 && nq == 1)
-        return true;
+        return CONTACT_OWNER;
     double floor = cl->dist * (1.0 - SAME_CONTACT_REL);
     bool owner_found = false, we_own = false;
     for (size_t a = 0; a < np; a++) {
@@ -373,11 +381,11 @@ static bool owns_contact(const tk_strut_finder *f, const tk_curve *c, size_t i,
             bool ours = (x == i && y == j) || (x == j && y == i);
             if (!ours) {
                 if (x == y)
-                    return false;
+                    return CONTACT_NOT_MINIMUM;
                 tk_closest other;
                 edge_closest(f, c, x, y, &other);
                 if (other.dist < floor)
-                    return false;
+                    return CONTACT_NOT_MINIMUM;
             }
             if (!owner_found && pair_allowed(f, c, x, y)) {
                 owner_found = true;
@@ -385,7 +393,7 @@ static bool owns_contact(const tk_strut_finder *f, const tk_curve *c, size_t i,
             }
         }
     }
-    return we_own;
+    return we_own ? CONTACT_OWNER : CONTACT_DUPLICATE;
 }
 
 static void strut_from(const tk_strut_finder *f, size_t i, size_t j,
@@ -413,8 +421,14 @@ static void test_pair(query *qy, size_t i, size_t j)
     edge_closest(f, qy->c, i, j, &cl);
     if (qy->shortest_mode ? !(cl.dist < qy->bound) : !(cl.dist <= qy->bound))
         return;
-    if (!qy->plain && !owns_contact(f, qy->c, i, j, &cl))
-        return;
+    if (!qy->plain || qy->out) {
+        /* Listing pairs without the local-minimum test still leaves out
+         * the pairs that merely repeat a contact another pair reports:
+         * their columns in the flow's rigidity matrix would be copies. */
+        contact_role role = contact_role_of(f, qy->c, i, j, &cl);
+        if (role == CONTACT_DUPLICATE || (!qy->plain && role != CONTACT_OWNER))
+            return;
+    }
     if (qy->shortest_mode) {
         qy->bound = cl.dist;
         strut_from(f, i, j, &cl, &qy->best);
@@ -530,14 +544,14 @@ static int begin_query(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule, 
     return TK_OK;
 }
 
-int tk_strut_finder_find(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule,
-                         double tau, double bound, tk_strut_list *out, tk_error *err)
+static int find_pairs(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule, double tau,
+                      double bound, bool plain, tk_strut_list *out, tk_error *err)
 {
     int rc = begin_query(f, c, rule, tau, err);
     if (rc)
         return rc;
     size_t start = out->count;
-    query qy = {f, c, rule, bound, false, false, {{0}}, out, TK_OK};
+    query qy = {f, c, rule, bound, false, plain, {{0}}, out, TK_OK};
     if (f->nedges > 1 && bound >= 0.0)
         visit(&qy, 0, 0);
     if (qy.status != TK_OK)
@@ -546,6 +560,18 @@ int tk_strut_finder_find(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule
         qsort(out->items + start, out->count - start, sizeof *out->items,
               tk_strut_compare_edges);
     return TK_OK;
+}
+
+int tk_strut_finder_find(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule,
+                         double tau, double bound, tk_strut_list *out, tk_error *err)
+{
+    return find_pairs(f, c, rule, tau, bound, false, out, err);
+}
+
+int tk_strut_finder_find_pairs(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule,
+                               double tau, double bound, tk_strut_list *out, tk_error *err)
+{
+    return find_pairs(f, c, rule, tau, bound, true, out, err);
 }
 
 int tk_strut_finder_shortest(tk_strut_finder *f, const tk_curve *c, double *shortest,

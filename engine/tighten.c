@@ -253,6 +253,15 @@ static bool has_kink(const tk_run *r, size_t comp, size_t vertex, int edge)
 }
 
 /* Active constraints of the run's curve (the finder must be fitted to it).
+ * Struts are every admissible edge pair within the active tolerance, not
+ * only the doubly critical ones (tk_strut_finder_find_pairs).  Equation
+ * (4) asks d(e_i, e_j) >= tau of every admissible pair; where a contact
+ * lies on nearly parallel edges the pair next to it, whose closest point
+ * is the vertex towards the contact, is about as close, and a motion that
+ * keeps the contact's own pair to first order can bring that one closer
+ * at first order: the contact slides onto it (section 2.3's parallel
+ * case, which the paper left out as rare; in tight knots it is common).
+ * Without it the step control held such runs to steps of 1e-4.
  * At a kink each edge's radius function within the active tolerance is a
  * constraint of its own.  Holding only the smaller one (equation 3's min)
  * is not enough: the equalising motion keeps the two edges equally long,
@@ -264,8 +273,8 @@ static int find_active(tk_run *r, const tk_curve *c, tk_error *err)
     tk_strut_list_clear(&r->struts);
     r->nkinks = 0;
     double slack = 1.0 + r->opt.active_tolerance;
-    int rc = tk_strut_finder_find(r->finder, c, TK_ARC_ADMISSIBLE, r->tau, r->tau * slack,
-                                  &r->struts, err);
+    int rc = tk_strut_finder_find_pairs(r->finder, c, TK_ARC_ADMISSIBLE, r->tau,
+                                        r->tau * slack, &r->struts, err);
     tk_kink *found = NULL;
     size_t nfound = 0;
     if (!rc)
@@ -426,10 +435,9 @@ static int violation(tk_run *r, const tk_curve *c, double *out, tk_error *err)
     return TK_OK;
 }
 
-/* Section 4.6: Newton steps du solving A^T du = -R with minimum norm, R the
- * violations of the active constraints (0 for those that hold, so they
- * stay put to first order), until every violation is below the correction
- * tolerance.  Each step is damped until the worst violation falls (near-
+/* Section 4.6: Newton steps du solving A_V^T du = -R with minimum norm,
+ * R the violations of the violated constraints V among the active ones,
+ * until every violation is below the correction tolerance.  Each step is damped until the worst violation falls (near-
  * dependent constraints can make the regularised solution long); rescaling
  * about the centroid is the last resort, for small leftovers only.  On
  * return the finder is fitted to the curve. */
@@ -449,17 +457,34 @@ static int correct(tk_run *r, int *iterations, tk_error *err)
         size_t ns = r->struts.count, ncon = ns + r->nkinks;
         if (ncon == 0)
             break;
-        /* Aim a little inside the feasible set so rounding does not leave
-         * the constraint just violated. */
+        /* Only the violated constraints, each aimed a little inside the
+         * feasible set so rounding does not leave it just violated.  Asking
+         * the others to stay put (R = 0) makes the system inconsistent
+         * wherever two constraints have (nearly) the same gradient and only
+         * one is violated (the two edges at a vertex contact, the two
+         * radius functions at a kink): its minimum-norm answer is then
+         * long and useless.  Those that become violated join next time. */
         double aim = 0.5 * r->opt.correction_tolerance;
+        size_t nv = 0, nb = 0;
         for (size_t j = 0; j < ns; j++) {
-            double g = r->struts.items[j].length - r->tau;
-            r->rhs[j] = g < 0.0 ? -g + aim * r->tau : 0.0;
+            double deficit = r->tau * (1.0 + aim) - r->struts.items[j].length;
+            if (deficit > 0.0) {
+                r->struts.items[nv] = r->struts.items[j];
+                r->rhs[nv++] = deficit;
+            }
         }
         for (size_t k = 0; k < r->nkinks; k++) {
-            double g = r->kinks[k].minrad - r->min_radius;
-            r->rhs[ns + k] = g < 0.0 ? -g + aim * r->min_radius : 0.0;
+            double deficit = r->min_radius * (1.0 + aim) - r->kinks[k].minrad;
+            if (deficit > 0.0) {
+                r->kinks[nb] = r->kinks[k];
+                r->kink_edge[nb] = r->kink_edge[k];
+                r->rhs[nv + nb++] = deficit;
+            }
         }
+        r->struts.count = nv;
+        r->nkinks = nb;
+        if (nv + nb == 0)
+            break;
         cholmod_sparse *a = NULL;
         rc = build_matrix(r, c, &a, err);
         if (rc)
@@ -494,6 +519,9 @@ static int correct(tk_run *r, int *iterations, tk_error *err)
         if (!improved)
             break;
     }
+    /* The active sets were cut down to the violated constraints. */
+    if (!rc && *iterations > 0)
+        rc = find_active(r, c, err);
     if (rc || worst <= r->opt.correction_tolerance)
         return rc;
     if (worst > 10.0 * r->opt.overstep_tolerance)
@@ -558,6 +586,41 @@ static int record(tk_run *r, tk_step_report *rep, tk_error *err)
     return TK_OK;
 }
 
+/* Everything sized by the curve's vertices: the trial curve, the strut
+ * tree and the work vectors; the warm start is dropped (its edge indices
+ * refer to the old curve). */
+static int fit_to_curve(tk_run *r, tk_error *err)
+{
+    tk_curve_free(&r->trial);
+    tk_strut_finder_free(&r->finder);
+    int rc = tk_curve_copy(r->curve, &r->trial, err);
+    if (!rc)
+        rc = tk_strut_finder_new(r->curve, &r->finder, err);
+    if (rc)
+        return rc;
+    size_t nv = r->curve->nvert;
+    free(r->fixed);
+    free(r->grad);
+    free(r->motion);
+    free(r->work);
+    r->fixed = calloc(nv, sizeof *r->fixed);
+    r->grad = calloc(3 * nv, sizeof *r->grad);
+    r->motion = calloc(3 * nv, sizeof *r->motion);
+    r->work = calloc(3 * nv, sizeof *r->work);
+    if (!r->fixed || !r->grad || !r->motion || !r->work)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for a run of %zu vertices", nv);
+    for (size_t comp = 0; comp < r->curve->ncomp; comp++)
+        if (!r->curve->closed[comp]) {
+            r->fixed[r->curve->offset[comp]] = true;
+            r->fixed[r->curve->offset[comp + 1] - 1] = true;
+        }
+    tk_strut_list_clear(&r->known_struts);
+    r->nknown_kinks = 0;
+    tk_strut_list_clear(&r->struts);
+    r->nkinks = 0;
+    return TK_OK;
+}
+
 int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_error *err)
 {
     *out = NULL;
@@ -577,29 +640,13 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
     r->started = now_seconds();
     rc = prepare_curve(r, start, err);
     if (!rc)
-        rc = tk_curve_copy(r->curve, &r->trial, err);
-    if (!rc)
-        rc = tk_strut_finder_new(r->curve, &r->finder, err);
-    if (!rc)
         rc = tk_nnls_new(&r->nnls, err);
+    if (!rc)
+        rc = fit_to_curve(r, err);
     if (rc) {
         tk_run_free(&r);
         return rc;
     }
-    size_t nv = r->curve->nvert;
-    r->fixed = calloc(nv, sizeof *r->fixed);
-    r->grad = calloc(3 * nv, sizeof *r->grad);
-    r->motion = calloc(3 * nv, sizeof *r->motion);
-    r->work = calloc(3 * nv, sizeof *r->work);
-    if (!r->fixed || !r->grad || !r->motion || !r->work) {
-        tk_run_free(&r);
-        return tk_error_set(err, TK_ENOMEM, "out of memory for a run of %zu vertices", nv);
-    }
-    for (size_t comp = 0; comp < r->curve->ncomp; comp++)
-        if (!r->curve->closed[comp]) {
-            r->fixed[r->curve->offset[comp]] = true;
-            r->fixed[r->curve->offset[comp + 1] - 1] = true;
-        }
     int corrections = 0;
     rc = correct(r, &corrections, err);
     if (!rc)

@@ -87,6 +87,16 @@ int tk_strut_finder_find(tk_strut_finder *f, const tk_curve *c,
                          tk_arc_rule rule, double tau, double bound,
                          tk_strut_list *out, tk_error *err);
 
+/* The same without the local-minimum test: every edge pair passing the arc
+ * rule whose distance is <= bound, each with its own closest points, except
+ * that a local minimum on a vertex is still listed once, by its owner.  So
+ * the pairs next to a contact (whose closest points sit on the vertex
+ * towards it) are listed too: where edges are nearly parallel they are
+ * about as close, and they are the contact's next owners when it slides. */
+int tk_strut_finder_find_pairs(tk_strut_finder *f, const tk_curve *c,
+                               tk_arc_rule rule, double tau, double bound,
+                               tk_strut_list *out, tk_error *err);
+
 /* The shortest doubly critical self-distance of the curve (Definition 1),
  * by branch and bound on the tree; +INFINITY when there is none (e.g. a
  * single open edge).  If where is non-NULL it receives that strut. */
