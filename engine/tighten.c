@@ -55,6 +55,7 @@ struct tk_run {
     size_t nsnapshots, snapshot_capacity;
     double step_size;
     int tiny_steps;
+    double resolved_at;  /* ropelength at the last re-resolution */
     double started;
     tk_stop_reason stop;
     atomic_int cancel;
@@ -114,6 +115,13 @@ static int check_options(const tk_options *o, tk_error *err)
                             "0 < active < 0.5");
     if (!(o->equalise >= 0.0) || !isfinite(o->equalise))
         return tk_error_set(err, TK_EINVAL, "equalise gain must be >= 0");
+    if (!(o->re_resolve >= 0.0 && o->re_resolve < 1.0))
+        return tk_error_set(err, TK_EINVAL, "re_resolve must be in [0, 1) (got %g)",
+                            o->re_resolve);
+    if (o->re_resolve > 0.0 && o->snapshot_every > 0)
+        return tk_error_set(err, TK_EINVAL,
+                            "re_resolve changes the vertex count, which snapshots keep: "
+                            "use one or the other");
     return TK_OK;
 }
 
@@ -621,6 +629,61 @@ static int fit_to_curve(tk_run *r, tk_error *err)
     return TK_OK;
 }
 
+/* Re-resolution during the run: the start was resampled to `resolution`
+ * vertices per unit of ropelength, and as the knot tightens that count
+ * grows finer than asked for.  Finer than needed costs twice: every step
+ * solves for more constraints, and the step the flow can take (explicit
+ * Euler on the length gradient, whose stiffness grows as the edges
+ * shorten, and the overstep control at kinks) shrinks with the edges.
+ * When the ropelength has fallen by the re_resolve fraction since the
+ * last resampling and the count is that much too fine, the curve is
+ * resampled along its spline to ceil(resolution * ropelength) vertices
+ * and scaled about its centroid just enough to be feasible again (costing
+ * as much length, relatively, as the resampling cost thickness). */
+static int maybe_re_resolve(tk_run *r, tk_error *err)
+{
+    const tk_options *o = &r->opt;
+    double rope = r->latest.ropelength;
+    if (!(o->re_resolve > 0.0) || !(o->resolution > 0.0) || !isfinite(rope))
+        return TK_OK;
+    if (!isfinite(r->resolved_at)) {
+        r->resolved_at = rope;
+        return TK_OK;
+    }
+    double want = ceil(o->resolution * rope);
+    if (!(rope < r->resolved_at * (1.0 - o->re_resolve)) ||
+        !(want < (double)r->curve->nvert * (1.0 - o->re_resolve)))
+        return TK_OK;
+    tk_curve *resampled = NULL;
+    int rc = tk_curve_resample_total(r->curve, (size_t)want, &resampled, err);
+    if (rc)
+        return rc;
+    tk_curve_free(&r->curve);
+    r->curve = resampled;
+    r->resolved_at = rope;
+    rc = fit_to_curve(r, err);
+    double worst = 0.0;
+    if (!rc)
+        rc = violation(r, r->curve, &worst, err);
+    if (rc)
+        return rc;
+    if (worst > 0.0) {
+        /* Distances and radii scale with the curve: this restores them. */
+        double centre[3], back[3];
+        tk_curve_centroid(r->curve, centre);
+        for (int k = 0; k < 3; k++) {
+            back[k] = centre[k];
+            centre[k] = -centre[k];
+        }
+        tk_curve_translate(r->curve, centre);
+        tk_curve_scale(r->curve, (1.0 + 0.5 * o->correction_tolerance) / (1.0 - worst));
+        tk_curve_translate(r->curve, back);
+        tk_strut_finder_refit(r->finder, r->curve);
+    }
+    r->step_size = 0.0;
+    return TK_OK;
+}
+
 int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_error *err)
 {
     *out = NULL;
@@ -647,6 +710,7 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
         tk_run_free(&r);
         return rc;
     }
+    r->resolved_at = INFINITY;
     int corrections = 0;
     rc = correct(r, &corrections, err);
     if (!rc)
@@ -985,8 +1049,13 @@ int tk_run_step(tk_run *r, tk_error *err)
     }
     tk_step_report rep = {0};
     rep.step = r->latest.step + 1;
+    int rc = maybe_re_resolve(r, err);
+    if (rc) {
+        r->stop = TK_STOP_FAILED;
+        return rc;
+    }
     tk_strut_finder_refit(r->finder, r->curve);
-    int rc = find_active(r, r->curve, err);
+    rc = find_active(r, r->curve, err);
     if (!rc)
         rc = resolve(r, &rep, err);
     if (!rc)

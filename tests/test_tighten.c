@@ -138,6 +138,47 @@ START_TEST(generated_chain_of_three_tightens_to_12_pi_plus_4)
 }
 END_TEST
 
+START_TEST(re_resolution_keeps_the_resolution)
+{
+    /* A loose trefoil resampled at resolution 5 is too fine once it has
+     * tightened: the run resamples it to 5 vertices per unit of
+     * ropelength again, and stays feasible across the change (watch_step
+     * checks every step). */
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 0, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 5;
+    o.re_resolve = 0.05;
+    o.max_steps = quick() ? 150 : 400;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    size_t start = tk_run_curve(run)->nvert;
+    double rope0 = tk_run_latest(run)->ropelength;
+    watch w = {2 * o.radius, o.overstep_tolerance, 0, INFINITY, 0};
+    tk_run_set_progress(run, watch_step, &w);
+    tk_stop_reason why;
+    ck_assert_int_eq(tk_run_until(run, &why, &err), TK_OK);
+    const tk_step_report *last = tk_run_latest(run);
+    printf("re-resolved trefoil: %ld steps, %.2f s, ropelength %.6f, vertices %zu -> %zu\n",
+           last->step, last->seconds, last->ropelength, start, last->vertices);
+    ck_assert(last->ropelength < rope0 * 0.95);
+    ck_assert_uint_lt(last->vertices, start);
+    ck_assert_uint_eq(last->vertices, tk_run_curve(run)->nvert);
+    ck_assert_uint_ge(last->vertices, (size_t)ceil(5 * last->ropelength * 0.95));
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(tk_run_curve(run), NULL, &m, NULL), TK_OK);
+    ck_assert(m.thickness >= 2 * o.radius * (1 - o.overstep_tolerance));
+    tk_run_free(&run);
+    /* the vertex count changes, so snapshots (one layout) are refused */
+    o.snapshot_every = 10;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_EINVAL);
+    ck_assert(strstr(err.message, "re_resolve") != NULL);
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(catalogue_trefoil_at_resolution_5)
 {
     if (quick() || !tkt_catalogue_dir()) {
@@ -367,6 +408,7 @@ int main(void)
     tcase_set_timeout(tc, 900);
     tcase_add_test(tc, start_thinner_than_tube_is_refused);
     tcase_add_test(tc, history_and_snapshots);
+    tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, cancellation_stops_within_one_step);
     tcase_add_test(tc, parallel_runs_equal_serial_runs);
     tcase_add_test(tc, round_hopf_start_with_continuum_of_contacts);

@@ -55,11 +55,19 @@ typedef struct tk_options {
     double correction_tolerance; /* violations above this are corrected */
     double equalise;             /* gain of the edge-equalising motion */
     size_t snapshot_every;       /* keep the curve every K steps (0: never) */
+    double re_resolve;           /* with resolution > 0: whenever the ropelength
+                                    has fallen by this fraction since the last
+                                    resampling and the vertex count is that
+                                    much finer than resolution * ropelength,
+                                    resample to that count (and scale up just
+                                    enough to stay feasible); 0: never.  The
+                                    vertex count then changes during the run,
+                                    so it cannot be combined with snapshots. */
 } tk_options;
 
 #define TK_OPTIONS_INIT                                                                  \
     {                                                                                    \
-        0.5, 1.0, 0.0, false, 1.002, 0, 0.0, 0.0, 0.0, 20, 3e-4, 1e-5, 1e-6, 0.5, 0      \
+        0.5, 1.0, 0.0, false, 1.002, 0, 0.0, 0.0, 0.0, 20, 3e-4, 1e-5, 1e-6, 0.5, 0, 0.0 \
     }
 
 /* Why a run stopped. */
