@@ -64,9 +64,27 @@ n_struts=$(value struts "$tmp/result.json")
 [ "$(grep -o '"force"' "$tmp/struts.json" | wc -l)" -ge "$n_struts" ]
 check $? "struts file lists forces for $n_struts struts"
 
+# --re-resolve keeps the resolution as the knot tightens: fewer vertices
+# at the end than at the start, about resolution * ropelength of them
+"$tk" tighten "$tmp/trefoil.vect" --autoscale --resolution 5 --re-resolve 0.05 --steps 300 \
+    --json --log "$tmp/rr.tsv" -o "$tmp/rr.vect" >"$tmp/rr.json" 2>"$tmp/err"
+check $? "tighten --re-resolve exits 0: $(cat "$tmp/err")"
+# the start has ceil(5 * its ropelength) vertices
+first=$(awk -F'\t' 'NR == 2 { v = 5 * $3; printf "%d", (v == int(v)) ? v : int(v) + 1 }' "$tmp/rr.tsv")
+last=$(value vertices "$tmp/rr.json")
+rr_rope=$(value ropelength "$tmp/rr.json")
+[ -n "$first" ] && [ "$last" -lt "$first" ]
+check $? "re-resolution: $first vertices at the start, $last at the end"
+awk -v v="$last" -v r="$rr_rope" 'BEGIN { exit !(v >= 5 * r && v <= 5 * r * 1.06 + 1) }'
+check $? "re-resolution: $last vertices for ropelength $rr_rope at resolution 5"
+"$tk" info "$tmp/rr.vect" --json >"$tmp/rr-info.json"
+close "$(value ropelength "$tmp/rr-info.json")" "$rr_rope" 1e-12
+check $? "re-resolved output measured again: $(value ropelength "$tmp/rr-info.json") vs $rr_rope"
+
 # bad options: exit 1, named
 for args in "--radius 0" "--lambda -1" "--steps 2.5" "--resolution -1" "--time abc" \
-    "--residual nan" "--overstep 0.5" "--every 0" "--frobnicate 1"; do
+    "--residual nan" "--overstep 0.5" "--every 0" "--re-resolve 1" "--re-resolve 0.1" \
+    "--frobnicate 1"; do
     # shellcheck disable=SC2086
     "$tk" tighten "$tmp/trefoil.vect" $args >/dev/null 2>"$tmp/err"
     status=$?

@@ -188,6 +188,10 @@ static const char tighten_help[] =
     "  --overstep EPS    largest constraint violation a step may make, as a\n"
     "                    fraction of the diameter (default 1e-5; violations\n"
     "                    are corrected down to EPS / 10)\n"
+    "  --re-resolve F    with --resolution: each time the ropelength has fallen\n"
+    "                    by the fraction F, resample to resolution * ropelength\n"
+    "                    vertices again, keeping the resolution as the knot\n"
+    "                    tightens (e.g. 0.05; default 0: never)\n"
     "Stop criteria (the first met stops the run; default --steps 1000):\n"
     "  --steps N         after N steps\n"
     "  --time SECONDS    after this much wall time\n"
@@ -233,12 +237,13 @@ enum {
     OPT_LOG = 1u << 12,
     OPT_SNAPSHOTS = 1u << 13,
     OPT_EVERY = 1u << 14,
-    OPT_OVERSTEP = 1u << 15
+    OPT_OVERSTEP = 1u << 15,
+    OPT_RERESOLVE = 1u << 16
 };
 #define TIGHTEN_OPTIONS                                                                   \
     (OPT_JSON | OPT_RADIUS | OPT_LAMBDA | OPT_RESOLUTION | OPT_AUTOSCALE | OPT_STEPS |     \
      OPT_TIME | OPT_RESIDUAL | OPT_OUTPUT | OPT_STRUTS_OUT | OPT_LOG | OPT_SNAPSHOTS |     \
-     OPT_EVERY | OPT_OVERSTEP)
+     OPT_EVERY | OPT_OVERSTEP | OPT_RERESOLVE)
 
 typedef struct option_spec {
     const char *name;
@@ -263,6 +268,7 @@ static const option_spec option_specs[] = {
     {"snapshots", OPT_SNAPSHOTS, true},
     {"every", OPT_EVERY, true},
     {"overstep", OPT_OVERSTEP, true},
+    {"re-resolve", OPT_RERESOLVE, true},
 };
 
 typedef struct cli_args {
@@ -272,6 +278,7 @@ typedef struct cli_args {
     size_t vertices; /* 0: the generator's default */
     tk_job_options job; /* tighten's run options */
     double overstep;    /* 0: the engine's default */
+    double re_resolve;  /* tk_options.re_resolve */
     const char *output, *struts_out, *log_out, *snapshots;
     size_t every;
     int npos;        /* the arguments that are not options, in order */
@@ -385,6 +392,15 @@ static int apply_option(const char *cmd, unsigned flag, const char *value, cli_a
         a->overstep = x;
         return EXIT_OK;
     }
+    case OPT_RERESOLVE: {
+        double x = 0.0;
+        if (parse_real(cmd, "--re-resolve", value, &x))
+            return EXIT_USAGE;
+        if (!(x >= 0.0 && x < 1.0))
+            return usage_error(cmd, "--re-resolve: '%s' must be in [0, 1)", value);
+        a->re_resolve = x;
+        return EXIT_OK;
+    }
     case OPT_AUTOSCALE:
         a->job.autoscale = true;
         return EXIT_OK;
@@ -426,6 +442,7 @@ static int parse_args(const char *cmd, int argc, char **argv, unsigned allowed,
     tk_job_options defaults = TK_JOB_OPTIONS_INIT;
     a->job = defaults;
     a->overstep = 0.0;
+    a->re_resolve = 0.0;
     a->output = a->struts_out = a->log_out = a->snapshots = NULL;
     a->every = 100;
     a->npos = 0;
@@ -855,6 +872,10 @@ static int cmd_tighten(int argc, char **argv)
         run_opts.overstep_tolerance = a.overstep;
         run_opts.correction_tolerance = 0.1 * a.overstep;
     }
+    run_opts.re_resolve = a.re_resolve;
+    if (a.re_resolve > 0.0 && !(a.job.resolution > 0.0))
+        return usage_error("tighten", "--re-resolve needs --resolution (the vertices per unit "
+                                      "ropelength to keep)");
     const char *name = a.pos[0];
     tk_error err;
     tk_error_clear(&err);
