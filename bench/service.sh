@@ -7,7 +7,9 @@
 # connections, engine alone, with 200 connections, engine alone.  Prints
 # wrk's requests/s and p50/p99 latency and the engine's steps/s in each
 # window (from /metrics), so the cost of the load on the engine shows next
-# to the unloaded windows around it.  Never fails on time.
+# to the unloaded windows around it; then the same with paced polling (200
+# clients at 1 and at 10 polls a second each, bench/poll.mjs).  Never fails
+# on time.
 #
 # usage: bench/service.sh [BUILD_DIR] [CATALOGUE_DIR]   (WINDOW=10 by default)
 set -eu
@@ -71,11 +73,28 @@ loaded() {
     printf '%-22s %12s %10s %10s %14s\n' "GET job, $1 conns" "$rps" "$p50" "$p99" \
         "$(rate "$s0" "$s1" "$t0" "$t1")"
 }
+# Paced polling (bench/poll.mjs): CLIENTS clients, each one GET every
+# PERIOD ms whatever the answers take, as watching pages and scripts do.
+paced() {
+    s0=$(steps); t0=$(now)
+    out=$(node bench/poll.mjs "$url/v1/jobs/$first" "$1" "$2" "$window")
+    s1=$(steps); t1=$(now)
+    set -- "$1" "$2" $out
+    printf '%-22s %12s %10s %10s %14s\n' "$1 x $((1000 / $2))/s paced" "$3" "$4" "$5" \
+        "$(rate "$s0" "$s1" "$t0" "$t1")"
+    [ "$7" = 0 ] || echo "  ($7 requests failed)"
+}
 quiet
 loaded 50
 quiet
 loaded 200
 quiet
+if command -v node >/dev/null; then
+    paced 200 1000
+    quiet
+    paced 200 100
+    quiet
+fi
 peak=$(awk '/VmHWM/ {print $2, $3}' "/proc/$pid/status")
 echo "daemon peak memory: $peak"
 for id in $ids; do curl -sf -X DELETE "$url/v1/jobs/$id" >/dev/null || true; done
