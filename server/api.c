@@ -269,7 +269,7 @@ static mhd_result get_health(tk_api *a, struct MHD_Connection *c)
     tk_jobs_stats s;
     tk_jobs_stats_get(a->jobs, &s);
     json_t *o = json_pack("{s:s, s:I, s:I, s:I, s:I, s:f}", "status",
-                          atomic_load(&a->refusing) ? "stopping" : "ok", "workers",
+                          "ok", "workers",
                           (json_int_t)s.workers, "running", (json_int_t)s.running, "queued",
                           (json_int_t)s.queued, "queue_limit", (json_int_t)s.queue_limit,
                           "uptime", now_unix() - a->started);
@@ -860,6 +860,8 @@ static mhd_result handle(void *cls, struct MHD_Connection *c, const char *url,
     (void)version;
     tk_api *a = cls;
     request *rq = *con_cls;
+    /* only POST reads its body; any other method's body is skipped */
+    bool wants_body = !strcmp(method, "POST");
     if (!rq) {
         rq = calloc(1, sizeof *rq);
         if (!rq)
@@ -868,13 +870,17 @@ static mhd_result handle(void *cls, struct MHD_Connection *c, const char *url,
         /* refuse a declared oversized body before reading it */
         const char *length =
             MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
-        if (length && strtoull(length, NULL, 10) > a->cfg.max_body)
+        if (wants_body && length && strtoull(length, NULL, 10) > a->cfg.max_body)
             rq->too_large = true;
         if (rq->too_large || atomic_load(&a->refusing))
             goto answer;
         return MHD_YES;
     }
     if (*upload_data_size > 0) {
+        if (!wants_body) {
+            *upload_data_size = 0;
+            return MHD_YES;
+        }
         if (!rq->too_large && rq->len + *upload_data_size > a->cfg.max_body) {
             rq->too_large = true;
             free(rq->body);

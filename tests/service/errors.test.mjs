@@ -163,6 +163,12 @@ describe('oversized bodies get 413 (--max-body 1000)', () => {
         assert.equal(h.json.status, 413);
     });
 
+    test('a body on a method that takes none is skipped, not judged: DELETE is routed (404)', async () => {
+        const r = await d.req('DELETE', '/v1/jobs/999999', { body: big, type: 'text/plain' });
+        assert.equal(r.status, 404, r.text);
+        assert.match(r.json.detail, /no job 999999/);
+    });
+
     test('a body at the limit is read (and judged on its content)', async () => {
         const fits = TRIANGLE + '#' + 'x'.repeat(MAX_BODY - TRIANGLE.length - 2) + '\n';
         assert.equal(Buffer.byteLength(fits), MAX_BODY);
