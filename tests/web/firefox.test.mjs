@@ -20,6 +20,7 @@ import { mkdirSync } from 'node:fs';
 import { join } from 'node:path';
 import puppeteer from 'puppeteer-core';
 import { ARTIFACTS, sleep, startDaemon, api as daemonApi } from './daemon.mjs';
+import { canvasStatsInPage } from './canvas.mjs';
 
 const FIREFOX = process.env.TK_FIREFOX || '/usr/bin/firefox-esr';
 const XVFB = process.env.TK_XVFB || '/usr/bin/Xvfb';
@@ -62,28 +63,8 @@ function watchErrors(p) {
     p.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
 }
 
-// The share of the 3-D canvas that differs from the background, and the
-// number of distinct colours (quantised), as page.test.mjs reads them.
-async function canvasPixels() {
-    return page.evaluate(() => {
-        window.tightknot.view.renderNow();
-        const src = document.querySelector('#view3d canvas');
-        const w = src.width, h = src.height;
-        const c = document.createElement('canvas');
-        c.width = w; c.height = h;
-        const g = c.getContext('2d', { willReadFrequently: true });
-        g.drawImage(src, 0, 0);
-        const d = g.getImageData(0, 0, w, h).data;
-        const bg = [d[0], d[1], d[2]];
-        let other = 0;
-        const colours = new Set();
-        for (let i = 0; i < d.length; i += 4) {
-            if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 12) other++;
-            colours.add(((d[i] >> 3) << 10) | ((d[i + 1] >> 3) << 5) | (d[i + 2] >> 3));
-        }
-        return { w, h, share: other / (w * h), colours: colours.size };
-    });
-}
+// The 3-D canvas read back (see canvas.mjs).
+const canvasPixels = () => page.evaluate(canvasStatsInPage);
 
 const count = (sel) => page.$$eval(sel, (els) => els.length);
 const text = (sel) => page.$eval(sel, (el) => el.textContent);
