@@ -449,7 +449,7 @@ static int violation(tk_run *r, const tk_curve *c, double *out, tk_error *err)
  * dependent constraints can make the regularised solution long); rescaling
  * about the centroid is the last resort, for small leftovers only.  On
  * return the finder is fitted to the curve. */
-static int correct(tk_run *r, int *iterations, tk_error *err)
+static int correct_violations(tk_run *r, int *iterations, tk_error *err)
 {
     tk_curve *c = r->curve, *t = r->trial;
     size_t n3 = 3 * c->nvert;
@@ -527,9 +527,6 @@ static int correct(tk_run *r, int *iterations, tk_error *err)
         if (!improved)
             break;
     }
-    /* The active sets were cut down to the violated constraints. */
-    if (!rc && *iterations > 0)
-        rc = find_active(r, c, err);
     if (rc || worst <= r->opt.correction_tolerance)
         return rc;
     if (worst > 10.0 * r->opt.overstep_tolerance)
@@ -550,6 +547,44 @@ static int correct(tk_run *r, int *iterations, tk_error *err)
     tk_curve_translate(c, back);
     tk_strut_finder_refit(r->finder, c);
     return TK_OK;
+}
+
+/* Error recovery (correct_violations) cuts the active sets down to the
+ * violated constraints.  The step's own set, with the forces its NNLS
+ * gave, is what the step reports, so it is kept aside and put back rather
+ * than searched for again: the next step searches anyway. */
+static int correct(tk_run *r, int *iterations, tk_error *err)
+{
+    size_t ns = r->struts.count, nk = r->nkinks;
+    tk_strut *struts = ns ? malloc(ns * sizeof *struts) : NULL;
+    tk_kink *kinks = nk ? malloc(nk * sizeof *kinks) : NULL;
+    unsigned char *edges = nk ? malloc(nk * sizeof *edges) : NULL;
+    if ((ns && !struts) || (nk && (!kinks || !edges))) {
+        free(struts);
+        free(kinks);
+        free(edges);
+        return tk_error_set(err, TK_ENOMEM, "out of memory for error recovery");
+    }
+    if (ns)
+        memcpy(struts, r->struts.items, ns * sizeof *struts);
+    if (nk) {
+        memcpy(kinks, r->kinks, nk * sizeof *kinks);
+        memcpy(edges, r->kink_edge, nk * sizeof *edges);
+    }
+    int rc = correct_violations(r, iterations, err);
+    /* the lists only ever grow, so the saved sets fit where they were */
+    if (ns)
+        memcpy(r->struts.items, struts, ns * sizeof *struts);
+    r->struts.count = ns;
+    if (nk) {
+        memcpy(r->kinks, kinks, nk * sizeof *kinks);
+        memcpy(r->kink_edge, edges, nk * sizeof *edges);
+    }
+    r->nkinks = nk;
+    free(struts);
+    free(kinks);
+    free(edges);
+    return rc;
 }
 
 static int record(tk_run *r, tk_step_report *rep, tk_error *err)

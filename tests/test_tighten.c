@@ -401,12 +401,49 @@ START_TEST(history_and_snapshots)
 }
 END_TEST
 
+START_TEST(corrected_steps_report_their_forces)
+{
+    /* A step that needed error recovery still reports the struts it was
+     * resolved against, with their NNLS forces: the forces balance the
+     * gradient (residual < 1), so with struts active some force is
+     * positive. */
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 120, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    tk_run *run = NULL;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, NULL), TK_OK);
+    int checked = 0;
+    for (int step = 0; step < (quick() ? 150 : 600) && checked < 5; step++) {
+        ck_assert_int_eq(tk_run_step(run, NULL), TK_OK);
+        const tk_step_report *s = tk_run_latest(run);
+        size_t ns = 0;
+        const tk_strut *struts = tk_run_struts(run, &ns);
+        ck_assert_uint_eq(ns, s->struts);
+        if (s->corrections == 0 || ns == 0 || !(s->residual < 0.99))
+            continue;
+        double largest = 0.0;
+        for (size_t k = 0; k < ns; k++) {
+            ck_assert(struts[k].force >= 0.0);
+            largest = fmax(largest, struts[k].force);
+        }
+        ck_assert_msg(largest > 0.0, "step %ld: %zu struts after %d corrections, all forces 0",
+                      s->step, ns, s->corrections);
+        checked++;
+    }
+    ck_assert_msg(checked > 0, "no corrected step with struts to check");
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("tighten");
     TCase *tc = tcase_create("tighten");
     tcase_set_timeout(tc, 900);
     tcase_add_test(tc, start_thinner_than_tube_is_refused);
+    tcase_add_test(tc, corrected_steps_report_their_forces);
     tcase_add_test(tc, history_and_snapshots);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, cancellation_stops_within_one_step);
