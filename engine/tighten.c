@@ -15,6 +15,9 @@
  * this many of them in a row stop the run as stalled. */
 #define STALL_FRACTION 1e-12
 #define STALL_STEPS 20
+/* A step below this fraction of the largest allowed is tried again
+ * without the equalising motion. */
+#define SHORT_STEP_FRACTION 1e-6
 #define MAX_HALVINGS 50
 #define MAX_CORRECTIONS 25
 #define MAX_EXPANSIONS 8
@@ -55,6 +58,7 @@ struct tk_run {
     size_t nsnapshots, snapshot_capacity;
     double step_size;
     int tiny_steps;
+    bool equalising;     /* this step's motion includes the equalising one */
     double resolved_at;  /* ropelength at the last re-resolution */
     double started;
     tk_stop_reason stop;
@@ -847,8 +851,9 @@ static int remember_forces(tk_run *r, tk_error *err)
 }
 
 /* Resolves the motion against the active constraints (equation 13):
- * motion = u + A x with x >= 0 minimising |A x + u|. */
-static int resolve(tk_run *r, tk_step_report *rep, tk_error *err)
+ * motion = u + A x with x >= 0 minimising |A x + u|; with `equalise`, u
+ * includes the edge-equalising motion. */
+static int resolve_motion(tk_run *r, tk_step_report *rep, bool equalise, tk_error *err)
 {
     tk_curve *c = r->curve;
     size_t n3 = 3 * c->nvert;
@@ -858,7 +863,8 @@ static int resolve(tk_run *r, tk_step_report *rep, tk_error *err)
             r->grad[3 * v] = r->grad[3 * v + 1] = r->grad[3 * v + 2] = 0.0;
     for (size_t i = 0; i < n3; i++)
         r->motion[i] = -r->grad[i];
-    add_equalising_motion(r, c, r->motion);
+    if (equalise)
+        add_equalising_motion(r, c, r->motion);
     size_t ns = r->struts.count, ncon = ns + r->nkinks;
     double grad_norm = norm(r->grad, n3);
     rep->rcond = 1.0;
@@ -898,6 +904,28 @@ static int resolve(tk_run *r, tk_step_report *rep, tk_error *err)
     for (size_t k = 0; k < r->nkinks; k++)
         r->kinks[k].force = r->x[ns + k];
     return remember_forces(r, err);
+}
+
+/* The resolved motion of the length gradient alone shortens the curve at
+ * first order: by the NNLS optimality conditions (A x) . motion = 0, so
+ * grad . motion = -|motion|^2.  The equalising motion is tangential, but
+ * on a polygon it costs length at first order; near a constrained
+ * critical point the resolved gradient is small and that cost can
+ * outweigh it, so that no step along the motion shortens the curve and
+ * the run stalls short of the critical point.  The step then goes along
+ * the resolved gradient alone. */
+static int resolve(tk_run *r, tk_step_report *rep, tk_error *err)
+{
+    int rc = resolve_motion(r, rep, r->equalising, err);
+    if (rc || !r->equalising)
+        return rc;
+    double slope = 0.0;
+    for (size_t i = 0; i < 3 * r->curve->nvert; i++)
+        slope += r->grad[i] * r->motion[i];
+    if (slope < 0.0)
+        return TK_OK;
+    r->equalising = false;
+    return resolve_motion(r, rep, false, err);
 }
 
 static bool has_strut(const tk_strut_list *list, const tk_strut *s)
@@ -994,12 +1022,14 @@ static double largest_step(const tk_run *r)
 
 /* Section 4.5: the largest step, halving from twice the last one, whose
  * end point violates no constraint by more than the overstep tolerance.
- * Returns the step taken (0 if none was acceptable). */
-static int take_step(tk_run *r, tk_step_report *rep, tk_error *err)
+ * rep->step_size is the step taken (0 if none was acceptable), *allowed
+ * the largest step the motion allowed. */
+static int take_step(tk_run *r, tk_step_report *rep, double *allowed, tk_error *err)
 {
     tk_curve *c = r->curve, *t = r->trial;
     size_t n3 = 3 * c->nvert;
     double largest = largest_step(r);
+    *allowed = largest;
     if (!(largest > 0.0)) {
         rep->step_size = 0.0;
         return TK_OK;
@@ -1032,24 +1062,23 @@ static int take_step(tk_run *r, tk_step_report *rep, tk_error *err)
                 if (rc)
                     return rc;
                 largest = largest_step(r);
+                *allowed = largest;
                 h = 2.0 * fmin(h, largest); /* undo this iteration's halving */
                 continue;
             }
         }
         /* The resolved motion shortens the curve to first order; a step
          * that makes it longer went too far along a curved constraint. */
-        if (worst <= r->opt.overstep_tolerance && tk_curve_length(t) <= length_before) {
+        if (worst <= r->opt.overstep_tolerance && tk_curve_length(t) < length_before) {
             memcpy(c->xyz, t->xyz, n3 * sizeof *c->xyz);
             r->step_size = h;
             rep->step_size = h;
-            r->tiny_steps = h < STALL_FRACTION * largest ? r->tiny_steps + 1 : 0;
             return TK_OK;
         }
     }
     tk_strut_finder_refit(r->finder, c);
     rep->step_size = 0.0;
     r->step_size = 0.0;
-    r->tiny_steps++;
     return TK_OK;
 }
 
@@ -1091,10 +1120,24 @@ int tk_run_step(tk_run *r, tk_error *err)
     }
     tk_strut_finder_refit(r->finder, r->curve);
     rc = find_active(r, r->curve, err);
+    r->equalising = r->opt.equalise > 0.0;
     if (!rc)
         rc = resolve(r, &rep, err);
+    double allowed = 0.0;
     if (!rc)
-        rc = take_step(r, &rep, err);
+        rc = take_step(r, &rep, &allowed, err);
+    /* Near a critical point the equalising motion, nearly orthogonal to
+     * the gradient, can make the length rise at second order faster than
+     * the motion lowers it at first: the step search then finds nothing.
+     * The step goes along the resolved gradient alone instead. */
+    if (!rc && r->equalising && !(rep.step_size >= SHORT_STEP_FRACTION * allowed)) {
+        r->equalising = false;
+        r->step_size = 0.0;
+        rc = resolve(r, &rep, err);
+        if (!rc)
+            rc = take_step(r, &rep, &allowed, err);
+    }
+    r->tiny_steps = rep.step_size < STALL_FRACTION * allowed ? r->tiny_steps + 1 : 0;
     double worst = 0.0;
     if (!rc)
         rc = violation(r, r->curve, &worst, err);
