@@ -308,9 +308,10 @@ static nnls_slot *slot_find(tk_nnls *s, const cholmod_sparse *T, uint64_t h)
     return NULL;
 }
 
-/* Analyses T into the least recently used slot. */
-static int slot_fill(tk_nnls *s, const cholmod_sparse *T, uint64_t h, nnls_slot **out,
-                     tk_error *err)
+/* Analyses T into the least recently used slot, with the fill-reducing
+ * ordering `order` of T's rows (NULL: AMD's own for this T). */
+static int slot_fill(tk_nnls *s, const cholmod_sparse *T, const int *order, uint64_t h,
+                     nnls_slot **out, tk_error *err)
 {
     nnls_slot *slot = &s->slot[0];
     for (int k = 1; k < NNLS_SLOTS && slot->L; k++)
@@ -326,7 +327,13 @@ static int slot_fill(tk_nnls *s, const cholmod_sparse *T, uint64_t h, nnls_slot 
         return tk_error_set(err, TK_ENOMEM, "out of memory for the factor cache");
     }
     /* cholmod_analyze takes a non-const matrix but does not change it */
-    slot->L = cholmod_analyze((cholmod_sparse *)T, &s->cc);
+    if (order) {
+        s->cc.method[0].ordering = CHOLMOD_GIVEN;
+        slot->L = cholmod_analyze_p((cholmod_sparse *)T, (int *)order, NULL, 0, &s->cc);
+        s->cc.method[0].ordering = CHOLMOD_AMD;
+    } else {
+        slot->L = cholmod_analyze((cholmod_sparse *)T, &s->cc);
+    }
     if (!slot->L || s->cc.status < CHOLMOD_OK) {
         int rc = cholmod_failure(s, "analyze", err);
         slot_clear(s, slot);
@@ -391,20 +398,21 @@ static int factor_once(tk_nnls *s, const cholmod_sparse *T, cholmod_factor *L, d
     return TK_OK;
 }
 
-/* Factors T T' (= the scaled A_F^T A_F, unit diagonal), with
+/* Factors T T' (= the scaled A_F^T A_F, unit diagonal) in the row order
+ * `order` (NULL: AMD's), with
  * delta I added when needed: first with delta_min (0: none), then, when
  * may_regularise, with delta growing by NNLS_DELTA_GROWTH from
  * NNLS_DELTA_FIRST up to NNLS_DELTA_CAP until the estimate clears the
  * floor.  Without may_regularise a singular matrix sets f->singular and
  * is not an error. */
-static int factor_normal(tk_nnls *s, const cholmod_sparse *T, double delta_min,
-                         bool may_regularise, double rcond_floor, nnls_factor *f,
-                         tk_error *err)
+static int factor_normal(tk_nnls *s, const cholmod_sparse *T, const int *order,
+                         double delta_min, bool may_regularise, double rcond_floor,
+                         nnls_factor *f, tk_error *err)
 {
     uint64_t h = pattern_hash(T);
     nnls_slot *slot = slot_find(s, T, h);
     int rc = TK_OK;
-    if (!slot && (rc = slot_fill(s, T, h, &slot, err)) != TK_OK)
+    if (!slot && (rc = slot_fill(s, T, order, h, &slot, err)) != TK_OK)
         return rc;
     slot->used = ++s->clock;
     f->L = slot->L;
@@ -566,6 +574,9 @@ typedef struct nnls_work {
     double *trial;        /* n: Lawson-Hanson's unconstrained solution */
     double *best;         /* n: the iterate with fewest violations */
     int *F;               /* passive indices, increasing */
+    int *order;           /* n: all columns in one fill-reducing order */
+    int *place;           /* n: column i's row in T (when passive) */
+    int *suborder;        /* n: the passive set in that order, as T's rows */
     int *next;            /* m: workspace of build_transpose */
     bool *passive;
     bool *blocked;        /* Lawson-Hanson: columns not to add again yet */
@@ -588,9 +599,26 @@ static void work_free(nnls_work *w)
     free(w->trial);
     free(w->best);
     free(w->F);
+    free(w->order);
+    free(w->place);
+    free(w->suborder);
     free(w->next);
     free(w->passive);
     free(w->blocked);
+}
+
+/* One fill-reducing order (AMD on A^T A) of all the columns.  A solve
+ * visits several passive sets, each a different normal matrix; ordering
+ * each afresh was a third of the flow's time.  The order of the whole
+ * matrix restricted to a passive set serves as that set's order. */
+static int order_columns(nnls_work *w, tk_error *err)
+{
+    for (size_t i = 0; i < w->n; i++)
+        w->F[i] = (int)i;
+    build_transpose(w->A, w->F, w->n, w->inv_norm, w->T, w->next);
+    if (!cholmod_amd(w->T, NULL, 0, w->order, &w->s->cc) || w->s->cc.status < CHOLMOD_OK)
+        return cholmod_failure(w->s, "amd", err);
+    return TK_OK;
 }
 
 static int work_alloc(nnls_work *w, tk_error *err)
@@ -606,11 +634,15 @@ static int work_alloc(nnls_work *w, tk_error *err)
     w->trial = malloc(n * sizeof *w->trial);
     w->best = calloc(n, sizeof *w->best);
     w->F = malloc(n * sizeof *w->F);
+    w->order = malloc(n * sizeof *w->order);
+    w->place = malloc(n * sizeof *w->place);
+    w->suborder = malloc(n * sizeof *w->suborder);
     w->next = malloc(m * sizeof *w->next);
     w->passive = calloc(n, sizeof *w->passive);
     w->blocked = calloc(n, sizeof *w->blocked);
     if (!w->colnorm || !w->inv_norm || !w->y || !w->r || !w->c || !w->zq || !w->res ||
-        !w->trial || !w->best || !w->F || !w->next || !w->passive || !w->blocked)
+        !w->trial || !w->best || !w->F || !w->order || !w->place || !w->suborder ||
+        !w->next || !w->passive || !w->blocked)
         return tk_error_set(err, TK_ENOMEM, "out of memory for nnls (%zu columns)", w->n);
     w->T = cholmod_allocate_sparse(w->n, w->m, matrix_nnz(w->A), 1, 1, 0, CHOLMOD_REAL,
                                    &w->s->cc);
@@ -623,7 +655,7 @@ static int work_alloc(nnls_work *w, tk_error *err)
         w->colnorm[i] = hi > lo ? norm2(Ax + lo, hi - lo) : 0.0;
         w->inv_norm[i] = w->colnorm[i] > 0.0 ? 1.0 / w->colnorm[i] : 0.0;
     }
-    return TK_OK;
+    return order_columns(w, err);
 }
 
 /* The unconstrained least-squares solution on the passive set into out
@@ -645,9 +677,15 @@ static int passive_solve(nnls_work *w, bool may_regularise, bool *singular, doub
     /* in the scaled variables zq_q = s_i x_i the normal matrix has a unit
      * diagonal */
     build_transpose(w->A, w->F, nf, w->inv_norm, w->T, w->next);
+    for (size_t q = 0; q < nf; q++)
+        w->place[w->F[q]] = (int)q;
+    size_t k = 0;
+    for (size_t j = 0; j < w->n; j++)
+        if (w->passive[w->order[j]])
+            w->suborder[k++] = w->place[w->order[j]];
     nnls_factor f = {NULL, 0.0, 1.0, 0, false};
-    int rc = factor_normal(w->s, w->T, may_regularise ? w->delta_mode : 0.0, may_regularise,
-                           w->rcond_floor, &f, err);
+    int rc = factor_normal(w->s, w->T, w->suborder, may_regularise ? w->delta_mode : 0.0,
+                           may_regularise, w->rcond_floor, &f, err);
     w->rep.factorisations += f.factorisations;
     w->rep.rcond = fmin(w->rep.rcond, f.rcond);
     if (rc != TK_OK)
@@ -1044,7 +1082,7 @@ int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, doubl
     }
     build_transpose(A, F, nf, inv_norm, T, next);
     nnls_factor f = {NULL, 0.0, 1.0, 0, false};
-    if ((rc = factor_normal(s, T, 0.0, true, NNLS_DEFAULT_RCOND_FLOOR, &f, err)) != TK_OK)
+    if ((rc = factor_normal(s, T, NULL, 0.0, true, NNLS_DEFAULT_RCOND_FLOOR, &f, err)) != TK_OK)
         goto done;
     /* r need not be in the range of A^T (dependent constraints with
      * different targets), so the refinement stays on the regularised
