@@ -75,8 +75,16 @@ tail -n +2 "$tmp/out/summary.tsv" >"$tmp/rows"
 while IFS="	" read -r name comps verts rope thick resid struts steps secs state; do
     [ "$state" = done ]
     check $? "$name: state $state"
-    [ "$steps" = 60 ]
-    check $? "$name: $steps steps, want 60"
+    # the unlink reaches its critical point (two round circles, residual
+    # 0) within the budget and stops there; the others use all 60 steps
+    if [ "$name" = 0.2.1 ]; then
+        [ "$steps" -ge 1 ] && [ "$steps" -le 60 ] &&
+            awk -v r="$resid" 'BEGIN {exit !(r < 1e-9)}'
+        check $? "$name: $steps steps (want at most 60) and residual $resid (want < 1e-9)"
+    else
+        [ "$steps" = 60 ]
+        check $? "$name: $steps steps, want 60"
+    fi
     id=$(awk -F"	" -v n="$name" '$1 == n {print $2}' "$tmp/out/jobs.tsv" | tail -n 1)
     curl -sf "$url/v1/jobs/$id" >"$tmp/job.json"
     check $? "$name: GET /v1/jobs/$id"
@@ -123,13 +131,13 @@ check $? "the refused file has its row"
 check $? "the done rows are kept next to the refused one"
 
 # status, fetch and cancel of single jobs
-first=$(head -n 1 "$tmp/out/jobs.tsv" | cut -f 2)
+first=$(awk -F"	" '$1 == "trefoil" {print $2; exit}' "$tmp/out/jobs.tsv")
 "$tk" remote --server "$url" status "$first" >"$tmp/status" 2>&1
 check $? "status exits 0"
 grep -q "^$first	.*	done	step 60	" "$tmp/status"
 check $? "status line: $(cat "$tmp/status")"
 "$tk" remote --server "$url" fetch --out "$tmp/fetched" "$first" >/dev/null 2>&1 &&
-    cmp -s "$tmp/fetched/job-$first.vect" "$tmp/out/$(head -n 1 "$tmp/out/jobs.tsv" | cut -f 1).vect"
+    cmp -s "$tmp/fetched/job-$first.vect" "$tmp/out/trefoil.vect"
 check $? "fetch downloads the same VECT"
 "$tk" remote --server "$url" cancel "$first" >/dev/null 2>"$tmp/cancel"
 [ $? -eq 2 ] && grep -q "already finished" "$tmp/cancel"
