@@ -29,6 +29,11 @@ static const char usage[] =
     "  --db FILE            job store (default var/tightknot.db; its directory\n"
     "                       is created when missing)\n"
     "  --workers N          threads running the engine (default: one per core)\n"
+    "  --worker-priority P  how the workers yield the CPU to answering requests:\n"
+    "                       idle (default: they use only CPU nothing else\n"
+    "                       wants, and requests preempt them at once), low\n"
+    "                       (niceness 5) or normal (for a machine shared with\n"
+    "                       other busy programs, where idle could starve them)\n"
     "  --queue-limit N      queued jobs before submissions get 429 (default 1000)\n"
     "  --max-vertices N     largest knot accepted, after re-resolution\n"
     "                       (default 200000)\n"
@@ -114,6 +119,9 @@ int main(int argc, char **argv)
             if (!parse_size(value, 1, 256, &n))
                 return bad_usage("--workers: '%s' must be from 1 to 256", value);
             jobs_cfg.workers = (size_t)n;
+        } else if (!strcmp(opt, "--worker-priority")) {
+            if (!tk_worker_priority_parse(value, &jobs_cfg.priority))
+                return bad_usage("--worker-priority: '%s' is not idle, low or normal", value);
         } else if (!strcmp(opt, "--queue-limit")) {
             if (!parse_size(value, 1, 10000000, &n))
                 return bad_usage("--queue-limit: '%s' must be from 1 to 10000000", value);

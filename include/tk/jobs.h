@@ -20,15 +20,28 @@
 #include "tk/error.h"
 #include "tk/store.h"
 
+/* How the worker threads yield the CPU to the threads answering requests
+ * (Linux scheduling; elsewhere they run as any thread). */
+typedef enum tk_worker_priority {
+    TK_WORKERS_IDLE = 0,   /* SCHED_IDLE: they run only on CPU nothing else
+                              wants, and a request preempts them at once */
+    TK_WORKERS_LOW,        /* niceness 5: a smaller share next to busy threads */
+    TK_WORKERS_NORMAL      /* like every other thread */
+} tk_worker_priority;
+
+/* "idle", "low" or "normal"; false for anything else. */
+bool tk_worker_priority_parse(const char *text, tk_worker_priority *out);
+
 typedef struct tk_jobs_config {
     size_t workers;        /* threads running the engine (>= 1) */
+    tk_worker_priority priority;
     size_t queue_limit;    /* queued jobs beyond this are refused (TK_EBUSY) */
     size_t max_vertices;   /* a run's vertex count limit, after re-resolution */
     double flush_seconds;  /* how often a running job is written to the store */
     size_t history_limit;  /* history entries kept per job (decimated beyond) */
 } tk_jobs_config;
 
-#define TK_JOBS_CONFIG_INIT {2, 1000, 1000000, 2.0, 2000}
+#define TK_JOBS_CONFIG_INIT {2, TK_WORKERS_IDLE, 1000, 1000000, 2.0, 2000}
 
 typedef struct tk_jobs tk_jobs;
 
