@@ -31,9 +31,10 @@ static double peak_mib(void)
  * published comparison figures), and the lowest ropelength seen at the
  * checkpoints. */
 typedef struct progress {
-    const double *thresholds;
+    double thresholds[3];
+    double older[3];         /* the older program's seconds; 0: a target */
     size_t nthresholds;
-    double crossed[4];
+    double crossed[3];
     double checkpoints[3];  /* seconds */
     double at_checkpoint[3];
 } progress;
@@ -65,24 +66,28 @@ static tk_curve *load(const char *dir, const char *name)
 
 static void run_knot(const char *dir, const char *name, double seconds, double re_resolve)
 {
-    static const double t31[] = {33.0, 32.80};
-    static const double t221[] = {25.15};
-    static const double t41[] = {42.5};
-    static const double t632[] = {58.6};
-    progress p = {NULL, 0, {-1, -1, -1, -1}, {10, 60, seconds}, {NAN, NAN, NAN}};
-    if (strcmp(name, "3.1") == 0) {
-        p.thresholds = t31;
-        p.nthresholds = 2;
-    } else if (strcmp(name, "2.2.1") == 0) {
-        p.thresholds = t221;
-        p.nthresholds = 1;
-    } else if (strcmp(name, "4.1") == 0) {
-        p.thresholds = t41;
-        p.nthresholds = 1;
-    } else if (strcmp(name, "6.3.2") == 0) {
-        p.thresholds = t632;
-        p.nthresholds = 1;
-    }
+    /* The published figures of the older program on this machine from
+     * the same files at the same resolution: a ropelength and the seconds
+     * it took to reach it, and the targets below them. */
+    static const struct {
+        const char *knot;
+        double ropelength[3], older_seconds[3];
+    } known[] = {
+        {"3.1", {33.0, 32.80, 32.7689}, {8.2, 12, 385}},
+        {"2.2.1", {25.15, 25.1483, 0}, {7.5, 175, 0}},
+        {"4.1", {44.73, 42.5, 0}, {354, 0, 0}},
+        {"5.1", {47.234, 0, 0}, {369, 0, 0}},
+        {"6.3.2", {75.03, 58.6, 0}, {340, 0, 0}},
+        {"10.1", {103.04, 0, 0}, {357, 0, 0}},
+    };
+    progress p = {{0}, {0}, 0, {-1, -1, -1}, {10, 60, seconds}, {NAN, NAN, NAN}};
+    for (size_t k = 0; k < sizeof known / sizeof known[0]; k++)
+        if (strcmp(name, known[k].knot) == 0)
+            for (int t = 0; t < 3 && known[k].ropelength[t] > 0; t++) {
+                p.thresholds[t] = known[k].ropelength[t];
+                p.older[t] = known[k].older_seconds[t];
+                p.nthresholds++;
+            }
     tk_curve *c = load(dir, name);
     if (!c)
         return;
@@ -102,16 +107,19 @@ static void run_knot(const char *dir, const char *name, double seconds, double r
     tk_stop_reason why;
     int rc = tk_run_until(run, &why, &err);
     const tk_step_report *last = tk_run_latest(run);
-    char crossed[128] = "";
+    char crossed[256] = "";
     size_t used = 0;
     for (size_t k = 0; k < p.nthresholds; k++) {
         int n;
+        char when[32], older[32] = "";
         if (p.crossed[k] >= 0)
-            n = snprintf(crossed + used, sizeof crossed - used, "%s<=%.2f@%.2fs", k ? " " : "",
-                         p.thresholds[k], p.crossed[k]);
+            snprintf(when, sizeof when, "%.2fs", p.crossed[k]);
         else
-            n = snprintf(crossed + used, sizeof crossed - used, "%s<=%.2f@never", k ? " " : "",
-                         p.thresholds[k]);
+            snprintf(when, sizeof when, "never");
+        if (p.older[k] > 0)
+            snprintf(older, sizeof older, "(older %gs)", p.older[k]);
+        n = snprintf(crossed + used, sizeof crossed - used, "%s<=%g@%s%s", k ? " " : "",
+                     p.thresholds[k], when, older);
         if (n > 0 && (size_t)n < sizeof crossed - used)
             used += (size_t)n;
     }
