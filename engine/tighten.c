@@ -18,6 +18,11 @@
 /* A step below this fraction of the largest allowed is tried again
  * without the equalising motion. */
 #define SHORT_STEP_FRACTION 1e-6
+/* Once the ropelength falls by less than POLISH_CHANGE (relative) over
+ * POLISH_WINDOW steps, the active tolerance shrinks by POLISH_FACTOR. */
+#define POLISH_WINDOW 200
+#define POLISH_CHANGE 1e-4
+#define POLISH_FACTOR (1.0 / 3.0)
 #define MAX_HALVINGS 50
 #define MAX_CORRECTIONS 25
 #define MAX_EXPANSIONS 8
@@ -59,6 +64,7 @@ struct tk_run {
     double step_size;
     int tiny_steps;
     bool equalising;     /* this step's motion includes the equalising one */
+    bool polishing;      /* the ropelength has all but stopped falling */
     double resolved_at;  /* ropelength at the last re-resolution */
     double started;
     tk_stop_reason stop;
@@ -280,11 +286,16 @@ static bool has_kink(const tk_run *r, size_t comp, size_t vertex, int edge)
  * the resolved motion then keeps the one function to first order while
  * the other falls at first order, and the step control must shrink the
  * step in proportion to the tolerance. */
+static double active_tolerance(const tk_run *r)
+{
+    return r->polishing ? POLISH_FACTOR * r->opt.active_tolerance : r->opt.active_tolerance;
+}
+
 static int find_active(tk_run *r, const tk_curve *c, tk_error *err)
 {
     tk_strut_list_clear(&r->struts);
     r->nkinks = 0;
-    double slack = 1.0 + r->opt.active_tolerance;
+    double slack = 1.0 + active_tolerance(r);
     int rc = tk_strut_finder_find_pairs(r->finder, c, TK_ARC_ADMISSIBLE, r->tau,
                                         r->tau * slack, &r->struts, err);
     tk_kink *found = NULL;
@@ -1138,6 +1149,11 @@ int tk_run_step(tk_run *r, tk_error *err)
             rc = take_step(r, &rep, &allowed, err);
     }
     r->tiny_steps = rep.step_size < STALL_FRACTION * allowed ? r->tiny_steps + 1 : 0;
+    if (!r->polishing && r->nhistory > POLISH_WINDOW) {
+        double before = r->history[r->nhistory - 1 - POLISH_WINDOW].ropelength;
+        double now = r->history[r->nhistory - 1].ropelength;
+        r->polishing = before - now < POLISH_CHANGE * now;
+    }
     double worst = 0.0;
     if (!rc)
         rc = violation(r, r->curve, &worst, err);

@@ -211,7 +211,7 @@ START_TEST(trefoil_does_not_stall_near_its_critical_point)
     tk_curve *c = tkt_catalogue_curve("3.1.vect");
     tk_options o = TK_OPTIONS_INIT;
     o.resolution = 5;
-    o.max_steps = 1300;
+    o.max_steps = 1600;
     tk_stop_reason why;
     double rope = tighten(c, &o, "3.1 to its critical point", &why);
     ck_assert_msg(why == TK_STOP_STEPS, "stopped: %s", tk_stop_reason_name(why));
