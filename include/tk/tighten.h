@@ -50,7 +50,9 @@ typedef struct tk_options {
                                     this (relative) over change_window steps */
     size_t change_window;
     /* Tolerances, relative to the diameter tau. */
-    double active_tolerance;     /* constraints this close are active */
+    double active_tolerance;     /* constraints this close are active; a third
+                                    of it once the ropelength has all but
+                                    stopped falling (the polishing phase) */
     double overstep_tolerance;   /* largest violation a step may introduce */
     double correction_tolerance; /* violations above this are corrected */
     double equalise;             /* gain of the edge-equalising motion */

@@ -83,7 +83,10 @@ describe('kill -9 and restart on the same store', () => {
                 `finished at step ${done.progress.step} after ${done.seconds.toFixed(2)} s`);
             assert.equal(done.state, 'done', JSON.stringify(done));
             assert.equal(done.stop_reason, 'time');
-            assert.ok(done.progress.step > live.progress.step, 'it continued past the step it was killed at');
+            // it goes on from the stored step (the live one was up to 2 s of
+            // steps further; how far past it the rest of the time budget
+            // takes the run depends on the CPU the worker gets)
+            assert.ok(done.progress.step > stored.progress.step, 'it continued past its stored step');
             assert.ok(done.seconds >= 6 - 0.05 && done.seconds < 9, `seconds ${done.seconds}`);
             assert.equal(done.progress.fraction, 1);
             assert.ok(done.started < done.finished);
