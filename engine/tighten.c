@@ -65,6 +65,7 @@ struct tk_run {
     int tiny_steps;
     bool equalising;     /* this step's motion includes the equalising one */
     bool polishing;      /* the ropelength has all but stopped falling */
+    size_t polish_from;  /* history entries before the last resampling */
     double resolved_at;  /* ropelength at the last re-resolution */
     double started;
     tk_stop_reason stop;
@@ -270,6 +271,18 @@ static bool has_kink(const tk_run *r, size_t comp, size_t vertex, int edge)
     return false;
 }
 
+/* The active tolerance of this step: a third of the option's once the run
+ * polishes.  A constraint within the tolerance holds the motion as if it
+ * were in contact; with a slack of up to 3e-4 of the diameter such
+ * constraints kept runs settling about 1e-4 (relative) above their
+ * critical points, while a tolerance that small from the start makes the
+ * loose phase slower (contacts are met mid-step and found by the step
+ * control instead). */
+static double active_tolerance(const tk_run *r)
+{
+    return r->polishing ? POLISH_FACTOR * r->opt.active_tolerance : r->opt.active_tolerance;
+}
+
 /* Active constraints of the run's curve (the finder must be fitted to it).
  * Struts are every admissible edge pair within the active tolerance, not
  * only the doubly critical ones (tk_strut_finder_find_pairs).  Equation
@@ -286,11 +299,6 @@ static bool has_kink(const tk_run *r, size_t comp, size_t vertex, int edge)
  * the resolved motion then keeps the one function to first order while
  * the other falls at first order, and the step control must shrink the
  * step in proportion to the tolerance. */
-static double active_tolerance(const tk_run *r)
-{
-    return r->polishing ? POLISH_FACTOR * r->opt.active_tolerance : r->opt.active_tolerance;
-}
-
 static int find_active(tk_run *r, const tk_curve *c, tk_error *err)
 {
     tk_strut_list_clear(&r->struts);
@@ -711,6 +719,10 @@ static int maybe_re_resolve(tk_run *r, tk_error *err)
     tk_curve_free(&r->curve);
     r->curve = resampled;
     r->resolved_at = rope;
+    /* a new polygon, further from its critical point: polishing starts
+     * again from its own history */
+    r->polishing = false;
+    r->polish_from = r->nhistory;
     rc = fit_to_curve(r, err);
     double worst = 0.0;
     if (!rc)
@@ -1149,7 +1161,7 @@ int tk_run_step(tk_run *r, tk_error *err)
             rc = take_step(r, &rep, &allowed, err);
     }
     r->tiny_steps = rep.step_size < STALL_FRACTION * allowed ? r->tiny_steps + 1 : 0;
-    if (!r->polishing && r->nhistory > POLISH_WINDOW) {
+    if (!r->polishing && r->nhistory > r->polish_from + POLISH_WINDOW) {
         double before = r->history[r->nhistory - 1 - POLISH_WINDOW].ropelength;
         double now = r->history[r->nhistory - 1].ropelength;
         r->polishing = before - now < POLISH_CHANGE * now;
