@@ -6,8 +6,8 @@
 # seconds: engine alone, engine while wrk polls GET /v1/jobs/{id}, engine
 # alone, ...  wrk runs twice per connection count: flat out (each
 # connection asks again as soon as it has its answer: saturation) and
-# paced (bench/paced.lua: each connection waits 100 ms between polls, as a
-# watching page or script does).  Prints wrk's requests/s and p50/p99
+# paced (bench/paced.lua: each connection waits 100 ms, or 1 s, between
+# polls, as a watching page or script does).  Prints wrk's requests/s and p50/p99
 # latency and, for the engine, its steps/s (from /metrics) and the CPU its
 # worker threads got (cores, from /proc: the steps' cost drifts as the knot
 # tightens, the CPU share does not), with the share of the mean of the
