@@ -929,26 +929,22 @@ static int resolve_motion(tk_run *r, tk_step_report *rep, bool equalise, tk_erro
     return remember_forces(r, err);
 }
 
-/* The resolved motion of the length gradient alone shortens the curve at
- * first order: by the NNLS optimality conditions (A x) . motion = 0, so
- * grad . motion = -|motion|^2.  The equalising motion is tangential, but
- * on a polygon it costs length at first order; near a constrained
- * critical point the resolved gradient is small and that cost can
- * outweigh it, so that no step along the motion shortens the curve and
- * the run stalls short of the critical point.  The step then goes along
- * the resolved gradient alone. */
 static int resolve(tk_run *r, tk_step_report *rep, tk_error *err)
 {
-    int rc = resolve_motion(r, rep, r->equalising, err);
-    if (rc || !r->equalising)
-        return rc;
+    return resolve_motion(r, rep, r->equalising, err);
+}
+
+/* Whether the motion shortens the curve at first order.  The resolved
+ * motion of the length gradient alone always does, unless it is 0: by the
+ * NNLS optimality conditions (A x) . motion = 0, so grad . motion =
+ * -|motion|^2.  With the equalising motion added it may not (see
+ * tk_run_step), and then no short step can pass the length test. */
+static bool descends(const tk_run *r)
+{
     double slope = 0.0;
     for (size_t i = 0; i < 3 * r->curve->nvert; i++)
         slope += r->grad[i] * r->motion[i];
-    if (slope < 0.0)
-        return TK_OK;
-    r->equalising = false;
-    return resolve_motion(r, rep, false, err);
+    return slope < 0.0;
 }
 
 static bool has_strut(const tk_strut_list *list, const tk_strut *s)
@@ -1053,8 +1049,9 @@ static int take_step(tk_run *r, tk_step_report *rep, double *allowed, tk_error *
     size_t n3 = 3 * c->nvert;
     double largest = largest_step(r);
     *allowed = largest;
-    if (!(largest > 0.0)) {
+    if (!(largest > 0.0) || !descends(r)) {
         rep->step_size = 0.0;
+        r->step_size = 0.0;
         return TK_OK;
     }
     double h = r->step_size > 0.0 ? fmin(2.0 * r->step_size, largest) : largest / 8.0;
@@ -1086,6 +1083,8 @@ static int take_step(tk_run *r, tk_step_report *rep, double *allowed, tk_error *
                     return rc;
                 largest = largest_step(r);
                 *allowed = largest;
+                if (!descends(r))
+                    break;
                 h = 2.0 * fmin(h, largest); /* undo this iteration's halving */
                 continue;
             }
@@ -1149,10 +1148,13 @@ int tk_run_step(tk_run *r, tk_error *err)
     double allowed = 0.0;
     if (!rc)
         rc = take_step(r, &rep, &allowed, err);
-    /* Near a critical point the equalising motion, nearly orthogonal to
-     * the gradient, can make the length rise at second order faster than
-     * the motion lowers it at first: the step search then finds nothing.
-     * The step goes along the resolved gradient alone instead. */
+    /* The equalising motion is tangential, but on a polygon it costs
+     * length at first order.  Near a constrained critical point the
+     * resolved gradient is small and that cost can outweigh it, or the
+     * length rises at second order faster than the motion lowers it at
+     * first: the step search then finds nothing (or next to nothing) and
+     * the run would stall short of the critical point.  The step goes
+     * along the resolved gradient alone instead. */
     if (!rc && r->equalising && !(rep.step_size >= SHORT_STEP_FRACTION * allowed)) {
         r->equalising = false;
         r->step_size = 0.0;
