@@ -179,20 +179,31 @@ START_TEST(re_resolution_keeps_the_resolution)
 }
 END_TEST
 
-START_TEST(catalogue_trefoil_at_resolution_5)
+/* Tightens the catalogue's 3.1 at resolution 5 for `steps` steps; false
+ * (the run skipped, saying why) in the quick form or without the
+ * catalogue. */
+static bool tighten_catalogue_trefoil(const char *what, bool autoscale, long steps,
+                                      double *rope, tk_stop_reason *why)
 {
     if (quick() || !tkt_catalogue_dir()) {
-        printf("trefoil run skipped (%s)\n", quick() ? "quick" : "catalogue absent");
-        return;
+        printf("%s skipped (%s)\n", what, quick() ? "quick" : "catalogue absent");
+        return false;
     }
     tk_curve *c = tkt_catalogue_curve("3.1.vect");
     tk_options o = TK_OPTIONS_INIT;
-    o.autoscale = true;
+    o.autoscale = autoscale;
     o.resolution = 5;
-    o.max_steps = 400;
-    double rope = tighten(c, &o, "3.1", NULL);
-    ck_assert_msg(rope <= 32.80, "ropelength %.6f", rope);
+    o.max_steps = steps;
+    *rope = tighten(c, &o, what, why);
     tk_curve_free(&c);
+    return true;
+}
+
+START_TEST(catalogue_trefoil_at_resolution_5)
+{
+    double rope;
+    if (tighten_catalogue_trefoil("3.1", true, 400, &rope, NULL))
+        ck_assert_msg(rope <= 32.80, "ropelength %.6f", rope);
 }
 END_TEST
 
@@ -204,19 +215,12 @@ START_TEST(trefoil_does_not_stall_near_its_critical_point)
      * curve.  The run must then step along the resolved gradient alone,
      * not stop as stalled (this one used to, after about 1150 steps, at
      * residual 0.012). */
-    if (quick() || !tkt_catalogue_dir()) {
-        printf("trefoil stall run skipped (%s)\n", quick() ? "quick" : "catalogue absent");
-        return;
-    }
-    tk_curve *c = tkt_catalogue_curve("3.1.vect");
-    tk_options o = TK_OPTIONS_INIT;
-    o.resolution = 5;
-    o.max_steps = 1600;
+    double rope;
     tk_stop_reason why;
-    double rope = tighten(c, &o, "3.1 to its critical point", &why);
+    if (!tighten_catalogue_trefoil("3.1 to its critical point", false, 1600, &rope, &why))
+        return;
     ck_assert_msg(why == TK_STOP_STEPS, "stopped: %s", tk_stop_reason_name(why));
     ck_assert_msg(rope <= 32.775, "ropelength %.6f", rope);
-    tk_curve_free(&c);
 }
 END_TEST
 
