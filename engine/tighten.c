@@ -18,11 +18,13 @@
 /* A step below this fraction of the largest allowed is tried again
  * without the equalising motion. */
 #define SHORT_STEP_FRACTION 1e-6
-/* Once the ropelength falls by less than POLISH_CHANGE (relative) over
- * POLISH_WINDOW steps, the active tolerance shrinks by POLISH_FACTOR. */
+/* Each time the ropelength falls by less than POLISH_CHANGE (relative;
+ * shrinking with the tolerances) over POLISH_WINDOW steps, the active
+ * tolerance shrinks by POLISH_FACTOR, at most POLISH_LEVELS times. */
 #define POLISH_WINDOW 200
 #define POLISH_CHANGE 1e-4
 #define POLISH_FACTOR (1.0 / 3.0)
+#define POLISH_LEVELS 4
 #define MAX_HALVINGS 50
 #define MAX_CORRECTIONS 25
 #define MAX_EXPANSIONS 8
@@ -64,8 +66,9 @@ struct tk_run {
     double step_size;
     int tiny_steps;
     bool equalising;     /* this step's motion includes the equalising one */
-    bool polishing;      /* the ropelength has all but stopped falling */
-    size_t polish_from;  /* history entries before the last resampling */
+    int polish_level;    /* times the ropelength has all but stopped falling */
+    size_t polish_from;  /* history entries before the last change of level
+                            or resampling */
     double resolved_at;  /* ropelength at the last re-resolution */
     double started;
     tk_stop_reason stop;
@@ -271,16 +274,39 @@ static bool has_kink(const tk_run *r, size_t comp, size_t vertex, int edge)
     return false;
 }
 
-/* The active tolerance of this step: a third of the option's once the run
- * polishes.  A constraint within the tolerance holds the motion as if it
- * were in contact; with a slack of up to 3e-4 of the diameter such
- * constraints kept runs settling about 1e-4 (relative) above their
- * critical points, while a tolerance that small from the start makes the
- * loose phase slower (contacts are met mid-step and found by the step
- * control instead). */
+/* The tolerances of this step: the options' while the ropelength falls,
+ * each a third smaller every time it all but stops (polishing).  A
+ * constraint within the active tolerance holds the motion as if it were
+ * in contact: with a slack of up to 3e-4 of the diameter such constraints
+ * kept runs settling about 1e-4 (relative) above their critical points
+ * (3.1 at resolution 5: 32.7719 at 3e-4, 32.7694 at 1e-4, 32.7689 at
+ * 1e-5), while a tolerance that small from the start makes the loose
+ * phase slower (contacts are met mid-step and found by the step control
+ * instead).  The overstep tolerance stays below the active one (a step's
+ * violations must be seen as active next time), the correction tolerance
+ * a tenth of that.  Shrinking them costs step length (steps along curved
+ * constraints grow as the square root of the overstep tolerance), so each
+ * level waits until the ropelength falls by less than the offset the
+ * current one leaves (about a third of its active tolerance, relative):
+ * a run that merely crawls (past a saddle) keeps its step sizes. */
+static double polish_scale(const tk_run *r)
+{
+    return pow(POLISH_FACTOR, r->polish_level);
+}
+
 static double active_tolerance(const tk_run *r)
 {
-    return r->polishing ? POLISH_FACTOR * r->opt.active_tolerance : r->opt.active_tolerance;
+    return r->opt.active_tolerance * polish_scale(r);
+}
+
+static double overstep_tolerance(const tk_run *r)
+{
+    return fmin(r->opt.overstep_tolerance, active_tolerance(r));
+}
+
+static double correction_tolerance(const tk_run *r)
+{
+    return fmin(r->opt.correction_tolerance, 0.1 * overstep_tolerance(r));
 }
 
 /* Active constraints of the run's curve (the finder must be fitted to it).
@@ -481,7 +507,7 @@ static int correct_violations(tk_run *r, int *iterations, tk_error *err)
     tk_strut_finder_refit(r->finder, c);
     double worst;
     rc = violation(r, c, &worst, err);
-    for (int it = 0; !rc && worst > r->opt.correction_tolerance && it < MAX_CORRECTIONS; it++) {
+    for (int it = 0; !rc && worst > correction_tolerance(r) && it < MAX_CORRECTIONS; it++) {
         rc = find_active(r, c, err);
         if (rc)
             return rc;
@@ -495,7 +521,7 @@ static int correct_violations(tk_run *r, int *iterations, tk_error *err)
          * one is violated (the two edges at a vertex contact, the two
          * radius functions at a kink): its minimum-norm answer is then
          * long and useless.  Those that become violated join next time. */
-        double aim = 0.5 * r->opt.correction_tolerance;
+        double aim = 0.5 * correction_tolerance(r);
         size_t nv = 0, nb = 0;
         for (size_t j = 0; j < ns; j++) {
             double deficit = r->tau * (1.0 + aim) - r->struts.items[j].length;
@@ -550,7 +576,7 @@ static int correct_violations(tk_run *r, int *iterations, tk_error *err)
         if (!improved)
             break;
     }
-    if (rc || worst <= r->opt.correction_tolerance)
+    if (rc || worst <= correction_tolerance(r))
         return rc;
     if (worst > 10.0 * r->opt.overstep_tolerance)
         return tk_error_set(err, TK_ENUMERIC,
@@ -566,7 +592,7 @@ static int correct_violations(tk_run *r, int *iterations, tk_error *err)
         centre[k] = -centre[k];
     }
     tk_curve_translate(c, centre);
-    tk_curve_scale(c, 1.0 / (1.0 - worst) * (1.0 + 0.5 * r->opt.correction_tolerance));
+    tk_curve_scale(c, 1.0 / (1.0 - worst) * (1.0 + 0.5 * correction_tolerance(r)));
     tk_curve_translate(c, back);
     tk_strut_finder_refit(r->finder, c);
     return TK_OK;
@@ -721,7 +747,7 @@ static int maybe_re_resolve(tk_run *r, tk_error *err)
     r->resolved_at = rope;
     /* a new polygon, further from its critical point: polishing starts
      * again from its own history */
-    r->polishing = false;
+    r->polish_level = 0;
     r->polish_from = r->nhistory;
     rc = fit_to_curve(r, err);
     double worst = 0.0;
@@ -967,7 +993,7 @@ static int expand_active(tk_run *r, const tk_curve *trial, size_t *added, tk_err
 {
     const tk_curve *c = r->curve;
     *added = 0;
-    double floor = 1.0 - r->opt.overstep_tolerance;
+    double floor = 1.0 - overstep_tolerance(r);
     tk_strut_list broken = {0};
     int rc = tk_strut_finder_find(r->finder, trial, TK_ARC_ADMISSIBLE, r->tau, r->tau * floor,
                                   &broken, err);
@@ -1065,7 +1091,7 @@ static int take_step(tk_run *r, tk_step_report *rep, double *allowed, tk_error *
         int rc = violation(r, t, &worst, err);
         if (rc)
             return rc;
-        if (worst > r->opt.overstep_tolerance && expansions < MAX_EXPANSIONS &&
+        if (worst > overstep_tolerance(r) && expansions < MAX_EXPANSIONS &&
             halving >= HALVINGS_BEFORE_EXPANDING) {
             /* Constraints the step keeps running into: make them active,
              * resolve again and retry the same step size.  Not at the first
@@ -1091,7 +1117,7 @@ static int take_step(tk_run *r, tk_step_report *rep, double *allowed, tk_error *
         }
         /* The resolved motion shortens the curve to first order; a step
          * that makes it longer went too far along a curved constraint. */
-        if (worst <= r->opt.overstep_tolerance && tk_curve_length(t) < length_before) {
+        if (worst <= overstep_tolerance(r) && tk_curve_length(t) < length_before) {
             memcpy(c->xyz, t->xyz, n3 * sizeof *c->xyz);
             r->step_size = h;
             rep->step_size = h;
@@ -1163,15 +1189,18 @@ int tk_run_step(tk_run *r, tk_error *err)
             rc = take_step(r, &rep, &allowed, err);
     }
     r->tiny_steps = rep.step_size < STALL_FRACTION * allowed ? r->tiny_steps + 1 : 0;
-    if (!r->polishing && r->nhistory > r->polish_from + POLISH_WINDOW) {
+    if (r->nhistory > r->polish_from + POLISH_WINDOW && r->polish_level < POLISH_LEVELS) {
         double before = r->history[r->nhistory - 1 - POLISH_WINDOW].ropelength;
         double now = r->history[r->nhistory - 1].ropelength;
-        r->polishing = before - now < POLISH_CHANGE * now;
+        if (before - now < POLISH_CHANGE * polish_scale(r) * now) {
+            r->polish_level++;
+            r->polish_from = r->nhistory;
+        }
     }
     double worst = 0.0;
     if (!rc)
         rc = violation(r, r->curve, &worst, err);
-    if (!rc && worst > 0.5 * r->opt.overstep_tolerance)
+    if (!rc && worst > 0.5 * overstep_tolerance(r))
         rc = correct(r, &rep.corrections, err);
     if (!rc)
         rc = violation(r, r->curve, &rep.violation, err);
