@@ -364,6 +364,9 @@ static int setup_run(tk_jobs *j, tk_job *job, job_run *jr, tk_error *err)
     tk_options opts;
     tk_job_options_to_run(&job->options, &opts);
     opts.snapshot_every = 0; /* frames are taken by the worker (take_frame) */
+    /* Frames and an interrupted job's stored curve keep one vertex count
+     * for the whole job: no coarse start. */
+    opts.coarse_to_fine = false;
     if (!rc && resume) {
         jr->step_offset = job->latest.step;
         jr->seconds_offset = job->latest.seconds;

@@ -150,6 +150,7 @@ START_TEST(re_resolution_keeps_the_resolution)
     o.autoscale = true;
     o.resolution = 5;
     o.re_resolve = 0.05;
+    o.coarse_to_fine = false; /* the resolution stays 5 from the start */
     o.max_steps = quick() ? 150 : 400;
     tk_run *run = NULL;
     tk_error err;
@@ -179,6 +180,55 @@ START_TEST(re_resolution_keeps_the_resolution)
 }
 END_TEST
 
+START_TEST(coarse_to_fine_ends_at_the_resolution)
+{
+    /* With a resolution the run starts on a polygon of half the vertices
+     * (2.5 per unit ropelength for resolution 5), tightens it until the
+     * ropelength all but stops falling, then doubles them: the run ends at
+     * resolution 5 of the input's ropelength, as without the coarse start,
+     * feasible at every step.  A stop on little change waits for the final
+     * polygon (the coarse one stops changing long before). */
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 0, &c, NULL), TK_OK);
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 5;
+    o.min_change = 1e-4;
+    o.change_window = 50;
+    o.max_steps = quick() ? 300 : 6000;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, (size_t)ceil(2.5 * m.ropelength));
+    watch w = {2 * o.radius, o.overstep_tolerance, 0, INFINITY, 0};
+    tk_run_set_progress(run, watch_step, &w);
+    tk_stop_reason why;
+    ck_assert_int_eq(tk_run_until(run, &why, &err), TK_OK);
+    const tk_step_report *last = tk_run_latest(run);
+    printf("coarse to fine trefoil: %ld steps, %.2f s, ropelength %.6f, vertices %zu, stop %s\n",
+           last->step, last->seconds, last->ropelength, last->vertices,
+           tk_stop_reason_name(why));
+    if (!quick()) {
+        ck_assert_int_eq(why, TK_STOP_CHANGE);
+        ck_assert_uint_eq(last->vertices, (size_t)ceil(5 * m.ropelength));
+        ck_assert_uint_eq(tk_run_curve(run)->nvert, last->vertices);
+        /* the tight trefoil is about 32.74; a polygon of 5 vertices per
+         * unit gets within a few thousandths */
+        ck_assert_msg(last->ropelength < 32.80, "ropelength %.6f", last->ropelength);
+    }
+    tk_run_free(&run);
+    /* snapshots keep one vertex count: no coarse start then */
+    o.snapshot_every = 10;
+    o.max_steps = 1;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, (size_t)ceil(5 * m.ropelength));
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 /* Tightens the catalogue's 3.1 at resolution 5 for `steps` steps; false
  * (the run skipped, saying why) in the quick form or without the
  * catalogue. */
@@ -202,7 +252,9 @@ static bool tighten_catalogue_trefoil(const char *what, bool autoscale, long ste
 START_TEST(catalogue_trefoil_at_resolution_5)
 {
     double rope;
-    if (tighten_catalogue_trefoil("3.1", true, 400, &rope, NULL))
+    /* about 450 steps on the coarse polygon (2.5 vertices per unit
+     * ropelength, whose own optimum is near 32.85), then the fine one */
+    if (tighten_catalogue_trefoil("3.1", true, 700, &rope, NULL))
         ck_assert_msg(rope <= 32.80, "ropelength %.6f", rope);
 }
 END_TEST
@@ -474,6 +526,7 @@ int main(void)
     tcase_add_test(tc, corrected_steps_report_their_forces);
     tcase_add_test(tc, history_and_snapshots);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
+    tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
     tcase_add_test(tc, cancellation_stops_within_one_step);
     tcase_add_test(tc, parallel_runs_equal_serial_runs);
     tcase_add_test(tc, round_hopf_start_with_continuum_of_contacts);

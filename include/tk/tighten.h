@@ -65,11 +65,18 @@ typedef struct tk_options {
                                     enough to stay feasible); 0: never.  The
                                     vertex count then changes during the run,
                                     so it cannot be combined with snapshots. */
+    bool coarse_to_fine;         /* with resolution > 0 and no snapshots: start
+                                    with half the vertices (a quarter, ...,
+                                    while that leaves 2.5 per unit
+                                    ropelength) and double them each time the
+                                    ropelength all but stops falling, up to
+                                    the resolution's count */
 } tk_options;
 
 #define TK_OPTIONS_INIT                                                                  \
     {                                                                                    \
-        0.5, 1.0, 0.0, false, 1.002, 0, 0.0, 0.0, 0.0, 20, 3e-4, 1e-5, 1e-6, 0.5, 0, 0.0 \
+        0.5, 1.0, 0.0, false, 1.002, 0, 0.0, 0.0, 0.0, 20, 3e-4, 1e-5, 1e-6, 0.5, 0, 0.0, \
+            true                                                                         \
     }
 
 /* Why a run stopped. */
