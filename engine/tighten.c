@@ -76,6 +76,7 @@ struct tk_run {
     double resolved_at;  /* ropelength at the last re-resolution */
     double start_ropelength; /* of the input, before any resampling */
     int coarse_level;    /* halvings of the vertex count still to undo */
+    int coarse_levels;   /* of them at the start */
     bool refine;         /* undo one at the start of the next step */
     size_t resampled_from; /* history entries before the last resampling */
     double started;
@@ -211,6 +212,7 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
             while (r->coarse_level < MAX_COARSE_LEVELS &&
                    r->opt.resolution / ldexp(1.0, r->coarse_level + 1) >= COARSEST_RESOLUTION)
                 r->coarse_level++;
+        r->coarse_levels = r->coarse_level;
         want = ceil(resolution_now(r) * m.ropelength);
         tk_curve *resampled = NULL;
         rc = tk_curve_resample_total(r->curve, (size_t)want, &resampled, err);
@@ -1202,6 +1204,19 @@ static void check_stop(tk_run *r)
             r->refine = true;
         else
             r->stop = TK_STOP_STALLED;
+    }
+    /* A run with a budget of steps or time spends its last share of it on
+     * the final polygon even when a coarse one is still tightening: each
+     * level's share is an equal part of the budget. */
+    if (r->coarse_level > 0) {
+        double spent = 0.0;
+        if (o->max_steps > 0)
+            spent = fmax(spent, (double)s->step / (double)o->max_steps);
+        if (o->max_seconds > 0.0)
+            spent = fmax(spent, s->seconds / o->max_seconds);
+        if (spent >= (double)(r->coarse_levels - r->coarse_level + 1) /
+                         (double)(r->coarse_levels + 1))
+            r->refine = true;
     }
 }
 

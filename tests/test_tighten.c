@@ -187,7 +187,8 @@ START_TEST(coarse_to_fine_ends_at_the_resolution)
      * ropelength all but stops falling, then doubles them: the run ends at
      * resolution 5 of the input's ropelength, as without the coarse start,
      * feasible at every step.  A stop on little change waits for the final
-     * polygon (the coarse one stops changing long before). */
+     * polygon (the coarse one stops changing long before), and so does a
+     * step budget. */
     tk_curve *c = NULL;
     ck_assert_int_eq(tk_generate_torus(2, 3, 0, &c, NULL), TK_OK);
     tk_measure m;
@@ -218,6 +219,16 @@ START_TEST(coarse_to_fine_ends_at_the_resolution)
          * unit gets within a few thousandths */
         ck_assert_msg(last->ropelength < 32.80, "ropelength %.6f", last->ropelength);
     }
+    tk_run_free(&run);
+    /* a step budget too short for the coarse polygon to settle still ends
+     * on the final one: the coarse level has half the budget */
+    o.min_change = 0.0;
+    o.max_steps = 40;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_int_eq(tk_run_until(run, &why, &err), TK_OK);
+    ck_assert_int_eq(why, TK_STOP_STEPS);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, (size_t)ceil(5 * m.ropelength));
+    ck_assert_uint_eq(tk_run_latest(run)->vertices, (size_t)ceil(5 * m.ropelength));
     tk_run_free(&run);
     /* snapshots keep one vertex count: no coarse start then */
     o.snapshot_every = 10;

@@ -192,6 +192,12 @@ static const char tighten_help[] =
     "                    by the fraction F, resample to resolution * ropelength\n"
     "                    vertices again, keeping the resolution as the knot\n"
     "                    tightens (e.g. 0.05; default 0: never)\n"
+    "  --no-coarse       with --resolution: start at that resolution; by\n"
+    "                    default the run starts with half the vertices (a\n"
+    "                    quarter, ... while 2.5 per unit ropelength remain)\n"
+    "                    and doubles them whenever the ropelength all but\n"
+    "                    stops falling, which gets past slow stretches of\n"
+    "                    the flow many times faster\n"
     "Stop criteria (the first met stops the run; default --steps 1000):\n"
     "  --steps N         after N steps\n"
     "  --time SECONDS    after this much wall time\n"
@@ -238,12 +244,13 @@ enum {
     OPT_SNAPSHOTS = 1u << 13,
     OPT_EVERY = 1u << 14,
     OPT_OVERSTEP = 1u << 15,
-    OPT_RERESOLVE = 1u << 16
+    OPT_RERESOLVE = 1u << 16,
+    OPT_NO_COARSE = 1u << 17
 };
 #define TIGHTEN_OPTIONS                                                                   \
     (OPT_JSON | OPT_RADIUS | OPT_LAMBDA | OPT_RESOLUTION | OPT_AUTOSCALE | OPT_STEPS |     \
      OPT_TIME | OPT_RESIDUAL | OPT_OUTPUT | OPT_STRUTS_OUT | OPT_LOG | OPT_SNAPSHOTS |     \
-     OPT_EVERY | OPT_OVERSTEP | OPT_RERESOLVE)
+     OPT_EVERY | OPT_OVERSTEP | OPT_RERESOLVE | OPT_NO_COARSE)
 
 typedef struct option_spec {
     const char *name;
@@ -269,6 +276,7 @@ static const option_spec option_specs[] = {
     {"every", OPT_EVERY, true},
     {"overstep", OPT_OVERSTEP, true},
     {"re-resolve", OPT_RERESOLVE, true},
+    {"no-coarse", OPT_NO_COARSE, false},
 };
 
 typedef struct cli_args {
@@ -279,6 +287,7 @@ typedef struct cli_args {
     tk_job_options job; /* tighten's run options */
     double overstep;    /* 0: the engine's default */
     double re_resolve;  /* tk_options.re_resolve */
+    bool no_coarse;     /* tk_options.coarse_to_fine off */
     const char *output, *struts_out, *log_out, *snapshots;
     size_t every;
     int npos;        /* the arguments that are not options, in order */
@@ -403,6 +412,9 @@ static int apply_option(const char *cmd, unsigned flag, const char *value, cli_a
     }
     case OPT_AUTOSCALE:
         a->job.autoscale = true;
+        return EXIT_OK;
+    case OPT_NO_COARSE:
+        a->no_coarse = true;
         return EXIT_OK;
     case OPT_EVERY: {
         long long n = 0;
@@ -873,6 +885,7 @@ static int cmd_tighten(int argc, char **argv)
         run_opts.correction_tolerance = 0.1 * a.overstep;
     }
     run_opts.re_resolve = a.re_resolve;
+    run_opts.coarse_to_fine = !a.no_coarse;
     if (a.re_resolve > 0.0 && !(a.job.resolution > 0.0))
         return usage_error("tighten", "--re-resolve needs --resolution (the vertices per unit "
                                       "ropelength to keep)");
