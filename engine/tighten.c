@@ -735,17 +735,6 @@ static int fit_to_curve(tk_run *r, tk_error *err)
     return TK_OK;
 }
 
-/* Re-resolution during the run: the start was resampled to `resolution`
- * vertices per unit of ropelength, and as the knot tightens that count
- * grows finer than asked for.  Finer than needed costs twice: every step
- * solves for more constraints, and the step the flow can take (explicit
- * Euler on the length gradient, whose stiffness grows as the edges
- * shorten, and the overstep control at kinks) shrinks with the edges.
- * When the ropelength has fallen by the re_resolve fraction since the
- * last resampling and the count is that much too fine, the curve is
- * resampled along its spline to ceil(resolution * ropelength) vertices
- * and scaled about its centroid just enough to be feasible again (costing
- * as much length, relatively, as the resampling cost thickness). */
 /* Resamples the run's curve to `count` vertices along its spline and
  * scales it about its centroid just enough to be feasible again. */
 static int resample_to(tk_run *r, size_t count, tk_error *err)
@@ -801,6 +790,17 @@ static int refine(tk_run *r, tk_error *err)
     return resample_to(r, (size_t)ceil(resolution_now(r) * rope), err);
 }
 
+/* Re-resolution during the run: the start was resampled to `resolution`
+ * vertices per unit of ropelength, and as the knot tightens that count
+ * grows finer than asked for.  Finer than needed costs twice: every step
+ * solves for more constraints, and the step the flow can take (explicit
+ * Euler on the length gradient, whose stiffness grows as the edges
+ * shorten, and the overstep control at kinks) shrinks with the edges.
+ * When the ropelength has fallen by the re_resolve fraction since the
+ * last resampling and the count is that much too fine, the curve is
+ * resampled along its spline to ceil(resolution * ropelength) vertices
+ * and scaled about its centroid just enough to be feasible again (costing
+ * as much length, relatively, as the resampling cost thickness). */
 static int maybe_re_resolve(tk_run *r, tk_error *err)
 {
     const tk_options *o = &r->opt;
@@ -1207,7 +1207,13 @@ static void check_stop(tk_run *r)
     }
     /* A run with a budget of steps or time spends its last share of it on
      * the final polygon even when a coarse one is still tightening: each
-     * level's share is an equal part of the budget. */
+     * level's share is an equal part of the budget.  A budget too small
+     * for that (a step or two) is overrun by one step per level, so the
+     * run still ends on the polygon of its resolution. */
+    if (r->coarse_level > 0 && (r->stop == TK_STOP_STEPS || r->stop == TK_STOP_TIME)) {
+        r->stop = TK_STOP_NONE;
+        r->refine = true;
+    }
     if (r->coarse_level > 0) {
         double spent = 0.0;
         if (o->max_steps > 0)

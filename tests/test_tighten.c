@@ -230,6 +230,14 @@ START_TEST(coarse_to_fine_ends_at_the_resolution)
     ck_assert_uint_eq(tk_run_curve(run)->nvert, (size_t)ceil(5 * m.ropelength));
     ck_assert_uint_eq(tk_run_latest(run)->vertices, (size_t)ceil(5 * m.ropelength));
     tk_run_free(&run);
+    /* one step is one too few: the run takes one more, on the final polygon */
+    o.max_steps = 1;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_int_eq(tk_run_until(run, &why, &err), TK_OK);
+    ck_assert_int_eq(why, TK_STOP_STEPS);
+    ck_assert_int_eq(tk_run_latest(run)->step, 2);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, (size_t)ceil(5 * m.ropelength));
+    tk_run_free(&run);
     /* snapshots keep one vertex count: no coarse start then */
     o.snapshot_every = 10;
     o.max_steps = 1;
