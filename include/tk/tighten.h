@@ -20,6 +20,8 @@
  *   5. error recovery: while some constraint is violated beyond the
  *      correction tolerance, Newton steps with the minimum-norm solution of
  *      A^T du = -R (section 4.6); rescaling only if that fails.
+ * With a resolution the run goes coarse to fine (coarse_to_fine): fewer
+ * vertices first, doubled whenever the ropelength all but stops falling.
  * Open components keep their end points fixed.
  *
  * Thread safety: a run is used by one thread at a time, except
@@ -51,8 +53,10 @@ typedef struct tk_options {
     size_t change_window;
     /* Tolerances, relative to the diameter tau. */
     double active_tolerance;     /* constraints this close are active; a third
-                                    of it once the ropelength has all but
-                                    stopped falling (the polishing phase) */
+                                    of it each time the ropelength all but
+                                    stops falling, four times at most (the
+                                    polishing; the overstep and correction
+                                    tolerances then stay below it) */
     double overstep_tolerance;   /* largest violation a step may introduce */
     double correction_tolerance; /* violations above this are corrected */
     double equalise;             /* gain of the edge-equalising motion */
