@@ -210,7 +210,7 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
                                 r->opt.resolution, m.ropelength, want);
         if (r->opt.coarse_to_fine && r->opt.snapshot_every == 0)
             while (r->coarse_level < MAX_COARSE_LEVELS &&
-                   r->opt.resolution / ldexp(1.0, r->coarse_level + 1) >= COARSEST_RESOLUTION)
+                   ldexp(r->opt.resolution, -(r->coarse_level + 1)) >= COARSEST_RESOLUTION)
                 r->coarse_level++;
         r->coarse_levels = r->coarse_level;
         want = ceil(resolution_now(r) * m.ropelength);
@@ -514,6 +514,23 @@ static int violation(tk_run *r, const tk_curve *c, double *out, tk_error *err)
     return TK_OK;
 }
 
+/* Scales the run's curve about its centroid, which raises every distance
+ * and radius in proportion, just enough to undo a violation of `worst`
+ * (a fraction of the bound), and fits the finder to it. */
+static void scale_to_feasible(tk_run *r, double worst)
+{
+    double centre[3], back[3];
+    tk_curve_centroid(r->curve, centre);
+    for (int k = 0; k < 3; k++) {
+        back[k] = centre[k];
+        centre[k] = -centre[k];
+    }
+    tk_curve_translate(r->curve, centre);
+    tk_curve_scale(r->curve, (1.0 + 0.5 * correction_tolerance(r)) / (1.0 - worst));
+    tk_curve_translate(r->curve, back);
+    tk_strut_finder_refit(r->finder, r->curve);
+}
+
 /* Section 4.6: Newton steps du solving A_V^T du = -R with minimum norm,
  * R the violations of the violated constraints V among the active ones,
  * until every violation is below the correction tolerance.  Each step is damped until the worst violation falls (near-
@@ -605,18 +622,7 @@ static int correct_violations(tk_run *r, int *iterations, tk_error *err)
                             "could not restore the thickness: constraints violated by %.3g of "
                             "the diameter after %d corrections",
                             worst, *iterations);
-    /* Scale up about the centroid, which raises every distance and radius
-     * in proportion: the small leftover violation goes away. */
-    double centre[3], back[3];
-    tk_curve_centroid(c, centre);
-    for (int k = 0; k < 3; k++) {
-        back[k] = centre[k];
-        centre[k] = -centre[k];
-    }
-    tk_curve_translate(c, centre);
-    tk_curve_scale(c, 1.0 / (1.0 - worst) * (1.0 + 0.5 * correction_tolerance(r)));
-    tk_curve_translate(c, back);
-    tk_strut_finder_refit(r->finder, c);
+    scale_to_feasible(r, worst);
     return TK_OK;
 }
 
@@ -757,19 +763,8 @@ static int resample_to(tk_run *r, size_t count, tk_error *err)
         rc = violation(r, r->curve, &worst, err);
     if (rc)
         return rc;
-    if (worst > 0.0) {
-        /* Distances and radii scale with the curve: this restores them. */
-        double centre[3], back[3];
-        tk_curve_centroid(r->curve, centre);
-        for (int k = 0; k < 3; k++) {
-            back[k] = centre[k];
-            centre[k] = -centre[k];
-        }
-        tk_curve_translate(r->curve, centre);
-        tk_curve_scale(r->curve, (1.0 + 0.5 * r->opt.correction_tolerance) / (1.0 - worst));
-        tk_curve_translate(r->curve, back);
-        tk_strut_finder_refit(r->finder, r->curve);
-    }
+    if (worst > 0.0)
+        scale_to_feasible(r, worst);
     r->step_size = 0.0;
     r->tiny_steps = 0;
     return TK_OK;
@@ -1210,10 +1205,6 @@ static void check_stop(tk_run *r)
      * level's share is an equal part of the budget.  A budget too small
      * for that (a step or two) is overrun by one step per level, so the
      * run still ends on the polygon of its resolution. */
-    if (r->coarse_level > 0 && (r->stop == TK_STOP_STEPS || r->stop == TK_STOP_TIME)) {
-        r->stop = TK_STOP_NONE;
-        r->refine = true;
-    }
     if (r->coarse_level > 0) {
         double spent = 0.0;
         if (o->max_steps > 0)
@@ -1221,8 +1212,12 @@ static void check_stop(tk_run *r)
         if (o->max_seconds > 0.0)
             spent = fmax(spent, s->seconds / o->max_seconds);
         if (spent >= (double)(r->coarse_levels - r->coarse_level + 1) /
-                         (double)(r->coarse_levels + 1))
+                         (double)(r->coarse_levels + 1)) {
             r->refine = true;
+            /* a stop on the budget has spent >= 1, above every share */
+            if (r->stop == TK_STOP_STEPS || r->stop == TK_STOP_TIME)
+                r->stop = TK_STOP_NONE;
+        }
     }
 }
 

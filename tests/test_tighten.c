@@ -42,6 +42,29 @@ static int watch_step(const tk_step_report *s, void *user)
     return w->cancel_at > 0 && s->step >= w->cancel_at;
 }
 
+/* Runs `run` (made with the options o) to its stop, checking every step's
+ * thickness (watch_step), and prints its figures; returns its last
+ * report. */
+static const tk_step_report *run_watched(tk_run *run, const tk_options *o, const char *what,
+                                         tk_stop_reason *why)
+{
+    tk_error err;
+    watch w = {2 * o->radius, o->overstep_tolerance, 0, INFINITY, 0};
+    tk_run_set_progress(run, watch_step, &w);
+    tk_stop_reason reason;
+    int rc = tk_run_until(run, &reason, &err);
+    ck_assert_msg(rc == TK_OK, "%s: %s", what, err.message);
+    tk_run_set_progress(run, NULL, NULL);
+    const tk_step_report *last = tk_run_latest(run);
+    printf("%s: %ld steps, %.2f s, ropelength %.6f, residual %.3g, struts %zu, vertices %zu, "
+           "stop %s\n",
+           what, last->step, last->seconds, last->ropelength, last->residual, last->struts,
+           last->vertices, tk_stop_reason_name(reason));
+    if (why)
+        *why = reason;
+    return last;
+}
+
 /* Tightens c with the options; returns the final ropelength. */
 static double tighten(const tk_curve *c, tk_options *o, const char *what, tk_stop_reason *why)
 {
@@ -49,21 +72,11 @@ static double tighten(const tk_curve *c, tk_options *o, const char *what, tk_sto
     tk_error err;
     int rc = tk_run_new(c, o, &run, &err);
     ck_assert_msg(rc == TK_OK, "%s: %s", what, err.message);
-    watch w = {2 * o->radius, o->overstep_tolerance, 0, INFINITY, 0};
-    tk_run_set_progress(run, watch_step, &w);
-    tk_stop_reason reason;
-    rc = tk_run_until(run, &reason, &err);
-    ck_assert_msg(rc == TK_OK, "%s: %s", what, err.message);
-    const tk_step_report *last = tk_run_latest(run);
-    printf("%s: %ld steps, %.2f s, ropelength %.6f, residual %.3g, struts %zu, stop %s\n", what,
-           last->step, last->seconds, last->ropelength, last->residual, last->struts,
-           tk_stop_reason_name(reason));
+    const tk_step_report *last = run_watched(run, o, what, why);
     /* the final curve measured afresh agrees with the run's figures */
     tk_measure m;
     ck_assert_int_eq(tk_thickness_measure(tk_run_curve(run), NULL, &m, NULL), TK_OK);
     ck_assert(tkt_reldiff(m.ropelength, last->ropelength) < 1e-12);
-    if (why)
-        *why = reason;
     double result = last->ropelength;
     tk_run_free(&run);
     return result;
@@ -157,13 +170,7 @@ START_TEST(re_resolution_keeps_the_resolution)
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
     size_t start = tk_run_curve(run)->nvert;
     double rope0 = tk_run_latest(run)->ropelength;
-    watch w = {2 * o.radius, o.overstep_tolerance, 0, INFINITY, 0};
-    tk_run_set_progress(run, watch_step, &w);
-    tk_stop_reason why;
-    ck_assert_int_eq(tk_run_until(run, &why, &err), TK_OK);
-    const tk_step_report *last = tk_run_latest(run);
-    printf("re-resolved trefoil: %ld steps, %.2f s, ropelength %.6f, vertices %zu -> %zu\n",
-           last->step, last->seconds, last->ropelength, start, last->vertices);
+    const tk_step_report *last = run_watched(run, &o, "re-resolved trefoil", NULL);
     ck_assert(last->ropelength < rope0 * 0.95);
     ck_assert_uint_lt(last->vertices, start);
     ck_assert_uint_eq(last->vertices, tk_run_curve(run)->nvert);
@@ -203,14 +210,8 @@ START_TEST(coarse_to_fine_ends_at_the_resolution)
     tk_error err;
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
     ck_assert_uint_eq(tk_run_curve(run)->nvert, (size_t)ceil(2.5 * m.ropelength));
-    watch w = {2 * o.radius, o.overstep_tolerance, 0, INFINITY, 0};
-    tk_run_set_progress(run, watch_step, &w);
     tk_stop_reason why;
-    ck_assert_int_eq(tk_run_until(run, &why, &err), TK_OK);
-    const tk_step_report *last = tk_run_latest(run);
-    printf("coarse to fine trefoil: %ld steps, %.2f s, ropelength %.6f, vertices %zu, stop %s\n",
-           last->step, last->seconds, last->ropelength, last->vertices,
-           tk_stop_reason_name(why));
+    const tk_step_report *last = run_watched(run, &o, "coarse to fine trefoil", &why);
     if (!quick()) {
         ck_assert_int_eq(why, TK_STOP_CHANGE);
         ck_assert_uint_eq(last->vertices, (size_t)ceil(5 * m.ropelength));
@@ -225,17 +226,17 @@ START_TEST(coarse_to_fine_ends_at_the_resolution)
     o.min_change = 0.0;
     o.max_steps = 40;
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
-    ck_assert_int_eq(tk_run_until(run, &why, &err), TK_OK);
+    last = run_watched(run, &o, "coarse to fine, 40 steps", &why);
     ck_assert_int_eq(why, TK_STOP_STEPS);
     ck_assert_uint_eq(tk_run_curve(run)->nvert, (size_t)ceil(5 * m.ropelength));
-    ck_assert_uint_eq(tk_run_latest(run)->vertices, (size_t)ceil(5 * m.ropelength));
+    ck_assert_uint_eq(last->vertices, (size_t)ceil(5 * m.ropelength));
     tk_run_free(&run);
     /* one step is one too few: the run takes one more, on the final polygon */
     o.max_steps = 1;
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
-    ck_assert_int_eq(tk_run_until(run, &why, &err), TK_OK);
+    last = run_watched(run, &o, "coarse to fine, 1 step", &why);
     ck_assert_int_eq(why, TK_STOP_STEPS);
-    ck_assert_int_eq(tk_run_latest(run)->step, 2);
+    ck_assert_int_eq(last->step, 2);
     ck_assert_uint_eq(tk_run_curve(run)->nvert, (size_t)ceil(5 * m.ropelength));
     tk_run_free(&run);
     /* snapshots keep one vertex count: no coarse start then */
@@ -271,7 +272,7 @@ static bool tighten_catalogue_trefoil(const char *what, bool autoscale, long ste
 START_TEST(catalogue_trefoil_at_resolution_5)
 {
     double rope;
-    /* about 450 steps on the coarse polygon (2.5 vertices per unit
+    /* half the steps on the coarse polygon (2.5 vertices per unit
      * ropelength, whose own optimum is near 32.85), then the fine one */
     if (tighten_catalogue_trefoil("3.1", true, 700, &rope, NULL))
         ck_assert_msg(rope <= 32.80, "ropelength %.6f", rope);
