@@ -244,6 +244,37 @@ int tk_curve_validate(const tk_curve *c, tk_error *err)
     return TK_OK;
 }
 
+int tk_curve_check_range(const tk_curve *c, tk_error *err)
+{
+    int rc = tk_curve_validate(c, err);
+    if (rc)
+        return rc;
+    for (size_t i = 0; i < c->ncomp; i++) {
+        size_t n = tk_curve_comp_vertices(c, i);
+        for (size_t k = 0; k < n; k++) {
+            const double *x = c->xyz + 3 * (c->offset[i] + k);
+            for (int a = 0; a < 3; a++)
+                if (!(fabs(x[a]) <= TK_CURVE_COORD_MAX))
+                    return tk_error_set(err, TK_EINVAL,
+                                        "component %zu vertex %zu has coordinate %c = %g, "
+                                        "beyond the +-%g the engine measures in: scale the "
+                                        "curve down",
+                                        i, k, "xyz"[a], x[a], TK_CURVE_COORD_MAX);
+        }
+        size_t ne = tk_curve_comp_edges(c, i);
+        for (size_t k = 0; k < ne; k++) {
+            double l = tk_curve_edge_length(c, i, k);
+            if (!(l >= TK_CURVE_EDGE_MIN))
+                return tk_error_set(err, TK_EINVAL,
+                                    "component %zu: the edge from vertex %zu to %zu is %g "
+                                    "long, shorter than the %g the engine measures: scale "
+                                    "the curve up or drop the vertex",
+                                    i, k, (k + 1) % n, l, TK_CURVE_EDGE_MIN);
+        }
+    }
+    return TK_OK;
+}
+
 /* Solves the tridiagonal system with sub-diagonal a, diagonal b,
  * super-diagonal c (a[0], c[n-1] unused) for three right-hand sides stored
  * as rhs[3*i + k], in place.  The spline matrices are strictly diagonally

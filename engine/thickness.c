@@ -8,7 +8,7 @@
 int tk_thickness_measure(const tk_curve *c, tk_strut_finder *f, tk_measure *out,
                          tk_error *err)
 {
-    int rc = tk_curve_validate(c, err);
+    int rc = tk_curve_check_range(c, err);
     if (rc)
         return rc;
     tk_strut_finder *own = NULL;
@@ -41,7 +41,7 @@ int tk_thickness_contacts(const tk_curve *c, double rel_tol, tk_measure *m,
     if (!(rel_tol >= 0.0))
         return tk_error_set(err, TK_EINVAL, "the tolerance must be >= 0 (got %g)", rel_tol);
     tk_strut_finder *f = NULL;
-    int rc = tk_curve_validate(c, err);
+    int rc = tk_curve_check_range(c, err);
     if (!rc)
         rc = tk_strut_finder_new(c, &f, err);
     if (!rc)

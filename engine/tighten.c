@@ -117,8 +117,9 @@ const char *tk_stop_reason_name(tk_stop_reason r)
 
 static int check_options(const tk_options *o, tk_error *err)
 {
-    if (!(o->radius > 0.0) || !isfinite(o->radius))
-        return tk_error_set(err, TK_EINVAL, "radius must be a positive number (got %g)", o->radius);
+    if (!(o->radius >= TK_CURVE_EDGE_MIN && o->radius <= TK_CURVE_COORD_MAX))
+        return tk_error_set(err, TK_EINVAL, "radius must be between %g and %g (got %g)",
+                            TK_CURVE_EDGE_MIN, TK_CURVE_COORD_MAX, o->radius);
     if (!(o->lambda > 0.0) || !isfinite(o->lambda))
         return tk_error_set(err, TK_EINVAL, "lambda must be a positive number (got %g)", o->lambda);
     if (!(o->resolution >= 0.0) || o->resolution > 1e4)
@@ -225,7 +226,16 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
             return rc;
     }
     if (r->opt.autoscale) {
-        tk_curve_scale(r->curve, r->opt.autoscale_margin * r->tau / m.thickness);
+        double factor = r->opt.autoscale_margin * r->tau / m.thickness;
+        tk_curve_scale(r->curve, factor);
+        /* A radius far from the curve's own scale can carry it out of the
+         * range the engine measures in. */
+        tk_error why;
+        if (tk_curve_check_range(r->curve, &why))
+            return tk_error_set(err, TK_EINVAL,
+                                "autoscale to radius %g scales the curve by %g, out of the "
+                                "engine's range (%s)",
+                                r->opt.radius, factor, why.message);
     } else if (m.thickness < r->tau * (1.0 - r->opt.overstep_tolerance) ||
                2.0 * m.minrad < 2.0 * r->min_radius * (1.0 - r->opt.overstep_tolerance)) {
         return tk_error_set(err, TK_EINVAL,

@@ -46,6 +46,10 @@ static int set_real(tk_job_options *o, const char *name, double x, tk_error *err
         if (!(x > 0.0))
             return tk_error_set(err, TK_EINVAL, "option '%s': must be positive, not %g", name,
                                 x);
+        if (!strcmp(name, "radius") && !(x >= TK_CURVE_EDGE_MIN && x <= TK_CURVE_COORD_MAX))
+            return tk_error_set(err, TK_EINVAL,
+                                "option 'radius': must be between %g and %g, not %g",
+                                TK_CURVE_EDGE_MIN, TK_CURVE_COORD_MAX, x);
         if (!strcmp(name, "radius"))
             o->radius = x;
         else

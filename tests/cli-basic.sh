@@ -162,6 +162,14 @@ lines=$(wc -l <"$tmp/err")
 if [ "$lines" -eq 1 ]; then pass; else fail "parse error: $lines lines on stderr, want 1"; fi
 expect_status 2 "struts on malformed VECT" "$tk" struts "$tmp/bad.vect"
 
+# Coordinates whose squares overflow once made the contact search widen
+# forever; now a clear refusal naming the vertex (timeout: a hang fails).
+printf 'VECT\n1 3 0\n-3\n0\n0 0 0\n1 0 0\n0 1e200 0\n' >"$tmp/huge.vect"
+expect_status 2 "info on a coordinate of 1e200" timeout 20 "$tk" info "$tmp/huge.vect"
+expect_match "vertex 2 has coordinate y = 1e\\+200, beyond the \\+-1e\\+30" "$tmp/err" \
+    "coordinate beyond the range is named"
+expect_status 2 "struts on a coordinate of 1e200" timeout 20 "$tk" struts "$tmp/huge.vect"
+
 # Every file is processed; one failure makes the status 2.
 expect_status 2 "info with a bad file among good ones" \
     "$tk" info --json "$tmp/hopf.vect" "$tmp/bad.vect" "$tmp/hopf.vect"

@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "support.h"
 #include "tk/generate.h"
@@ -265,6 +266,105 @@ START_TEST(contacts_of_tight_trefoil)
 }
 END_TEST
 
+/* A triangle (0,0,0), (1,0,0), (0,y,0). */
+static tk_curve *right_triangle(double y)
+{
+    size_t n = 3;
+    bool closed = true;
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_curve_new(&c, 1, &n, &closed, NULL), TK_OK);
+    c->xyz[3] = 1.0;
+    c->xyz[7] = y;
+    return c;
+}
+
+START_TEST(extreme_magnitudes_are_refused_in_bounded_time)
+{
+    /* Once squared distances overflow, no distance means anything; these
+     * once made the shortest-contact search widen its radius forever. */
+    const double ys[] = {1e200, 1e308, -1.7976931348623157e308, 1e31};
+    for (size_t k = 0; k < sizeof ys / sizeof *ys; k++) {
+        tk_curve *c = right_triangle(ys[k]);
+        ck_assert_int_eq(tk_curve_validate(c, NULL), TK_OK); /* a valid VECT */
+        tk_measure m;
+        tk_error err;
+        ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, &err), TK_EINVAL);
+        ck_assert_msg(strstr(err.message, "vertex 2 has coordinate y") &&
+                          strstr(err.message, "1e+30"),
+                      "%s", err.message);
+        tk_curve_free(&c);
+    }
+    /* Edges below the range, at a small overall scale. */
+    tk_curve *c = tkt_regular_polygon(12, 1e-31);
+    tk_measure m;
+    tk_error err;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, &err), TK_EINVAL);
+    ck_assert_msg(strstr(err.message, "shorter than the 1e-30"), "%s", err.message);
+    tk_curve_free(&c);
+}
+END_TEST
+
+START_TEST(shortest_contact_search_ends_on_any_finite_curve)
+{
+    /* The search itself, below the range check, must end whatever the
+     * magnitudes: with the box's diagonal infinite, or 600 orders of
+     * magnitude between the closest approach and the curve's size. */
+    const double ys[] = {1e200, 1e308, 1e-300};
+    for (size_t k = 0; k < sizeof ys / sizeof *ys; k++) {
+        tk_curve *c = right_triangle(ys[k]);
+        tk_strut_finder *f = NULL;
+        ck_assert_int_eq(tk_strut_finder_new(c, &f, NULL), TK_OK);
+        double shortest = 0.0;
+        ck_assert_int_eq(tk_strut_finder_shortest(f, c, &shortest, NULL, NULL), TK_OK);
+        /* A triangle's edges all share vertices: no admissible pair. */
+        ck_assert(isinf(shortest));
+        tk_strut_finder_free(&f);
+        tk_curve_free(&c);
+    }
+    /* Two far components, one 300 orders of magnitude smaller than the
+     * gap between them (squares still finite): their distance. */
+    size_t counts[2] = {4, 4};
+    bool closed[2] = {true, true};
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_curve_new(&c, 2, counts, closed, NULL), TK_OK);
+    const double sq[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int v = 0; v < 4; v++) {
+        c->xyz[3 * v] = 1e-150 * sq[v][0];
+        c->xyz[3 * v + 1] = 1e-150 * sq[v][1];
+        c->xyz[12 + 3 * v] = 1e150 * (2.0 + sq[v][0]);
+        c->xyz[12 + 3 * v + 1] = 1e150 * sq[v][1];
+    }
+    tk_strut_finder *f = NULL;
+    ck_assert_int_eq(tk_strut_finder_new(c, &f, NULL), TK_OK);
+    double shortest = 0.0;
+    ck_assert_int_eq(tk_strut_finder_shortest(f, c, &shortest, NULL, NULL), TK_OK);
+    ck_assert_msg(tkt_reldiff(shortest, 2e150) < 1e-12, "shortest %g", shortest);
+    tk_strut_finder_free(&f);
+    tk_curve_free(&c);
+}
+END_TEST
+
+START_TEST(measured_exactly_at_the_ends_of_the_range)
+{
+    /* Even regular n-gon (see regular_polygon_exact) at the largest and
+     * smallest scales the range admits. */
+    const double scales[] = {0.9e30, 3e-29, 1.0};
+    for (size_t k = 0; k < sizeof scales / sizeof *scales; k++) {
+        size_t n = 16;
+        tk_curve *c = tkt_regular_polygon(n, scales[k]);
+        tk_measure m;
+        tk_error err;
+        ck_assert_msg(tk_thickness_measure(c, NULL, &m, &err) == TK_OK, "%s", err.message);
+        double expect = 2.0 * scales[k] * cos(M_PI / (double)n);
+        ck_assert_msg(tkt_reldiff(m.thickness, expect) < 1e-13, "scale %g: thickness %.17g",
+                      scales[k], m.thickness);
+        double length = (double)n * 2.0 * scales[k] * sin(M_PI / (double)n);
+        ck_assert(tkt_reldiff(m.ropelength, 2.0 * length / expect) < 1e-13);
+        tk_curve_free(&c);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("thickness");
@@ -277,5 +377,12 @@ int main(void)
     tcase_add_test(tc, doubly_critical_matters);
     tcase_add_test(tc, contacts_of_tight_trefoil);
     suite_add_tcase(s, tc);
+    /* A hang here is the failure: a short timeout. */
+    TCase *range = tcase_create("range");
+    tcase_set_timeout(range, 20);
+    tcase_add_test(range, extreme_magnitudes_are_refused_in_bounded_time);
+    tcase_add_test(range, shortest_contact_search_ends_on_any_finite_curve);
+    tcase_add_test(range, measured_exactly_at_the_ends_of_the_range);
+    suite_add_tcase(s, range);
     return tkt_run_suite(s);
 }

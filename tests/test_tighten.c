@@ -354,6 +354,50 @@ START_TEST(start_thinner_than_tube_is_refused)
 }
 END_TEST
 
+START_TEST(radius_out_of_the_range_is_refused)
+{
+    /* A radius of 1e300 with autoscale once scaled the curve past
+     * overflow, and the contact search then never ended. */
+    tk_curve *c = tkt_regular_polygon(16, 10.0);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    tk_run *run = NULL;
+    tk_error err;
+    const double refused[] = {1e300, 1.01e30, 0.99e-30, INFINITY, NAN};
+    for (size_t k = 0; k < sizeof refused / sizeof *refused; k++) {
+        o.radius = refused[k];
+        ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_EINVAL);
+        ck_assert_msg(strstr(err.message, "radius must be between 1e-30 and 1e+30"), "%s",
+                      err.message);
+        ck_assert(run == NULL);
+    }
+    /* In range, but the autoscaled curve is not: a 16-gon's thickness is
+     * about a fifth of its extent, so scaling it to a radius of 1e30 puts
+     * its vertices near 1e31. */
+    o.radius = 1e30;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_EINVAL);
+    ck_assert_msg(strstr(err.message, "autoscale to radius 1e+30") &&
+                      strstr(err.message, "beyond the +-1e+30"),
+                  "%s", err.message);
+    /* Both ends of the range themselves run, and the scale does not change
+     * the figures: the same steps at radius 1e-29, 1e29 and 0.5. */
+    double rope[3];
+    const double radii[3] = {1e-29, 1e28, 0.5};
+    o.max_steps = 5;
+    for (int k = 0; k < 3; k++) {
+        o.radius = radii[k];
+        ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+        tk_stop_reason why;
+        ck_assert_msg(tk_run_until(run, &why, &err) == TK_OK, "%s", err.message);
+        rope[k] = tk_run_latest(run)->ropelength;
+        tk_run_free(&run);
+    }
+    ck_assert_msg(tkt_reldiff(rope[0], rope[2]) < 1e-4 && tkt_reldiff(rope[1], rope[2]) < 1e-4,
+                  "ropelength %.15g %.15g %.15g", rope[0], rope[1], rope[2]);
+    tk_curve_free(&c);
+}
+END_TEST
+
 typedef struct cancel_case {
     tk_run *run;
     long steps_at_cancel;
@@ -557,5 +601,10 @@ int main(void)
     tcase_add_test(tc, trefoil_does_not_stall_near_its_critical_point);
     tcase_add_test(tc, generated_chain_of_three_tightens_to_12_pi_plus_4);
     suite_add_tcase(s, tc);
+    /* A hang here is the failure: a short timeout. */
+    TCase *range = tcase_create("range");
+    tcase_set_timeout(range, 30);
+    tcase_add_test(range, radius_out_of_the_range_is_refused);
+    suite_add_tcase(s, range);
     return tkt_run_suite(s);
 }

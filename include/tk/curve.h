@@ -97,6 +97,21 @@ void tk_curve_centroid(const tk_curve *c, double centre[3]);
  * zero-length edge.  Fails with TK_EINVAL naming the first offence. */
 int tk_curve_validate(const tk_curve *c, tk_error *err);
 
+/* The magnitudes the engine measures and tightens in.  Squared distances
+ * and the gradients of minrad (powers of 1/|e| up to the second) must stay
+ * far from overflow and underflow for every finite input, so coordinates
+ * are bounded in magnitude and edges from below.  Any ordinary unit (a
+ * nanometre tube in metres, a light-year tube in metres) fits. */
+#define TK_CURVE_COORD_MAX 1e30
+#define TK_CURVE_EDGE_MIN 1e-30
+
+/* tk_curve_validate, and every coordinate within +-TK_CURVE_COORD_MAX and
+ * every edge at least TK_CURVE_EDGE_MIN long: what measuring a curve needs.
+ * A VECT file may hold any finite double (it round-trips exactly); this is
+ * the engine's domain, not the format's.  Fails with TK_EINVAL naming the
+ * first offence and the bound. */
+int tk_curve_check_range(const tk_curve *c, tk_error *err);
+
 /* A new curve whose component c has counts[c] vertices placed at equal
  * arclength along a C^2 cubic spline through the old vertices (periodic for
  * closed components, natural for open ones, parametrised by chord length).

@@ -38,7 +38,8 @@
 #include "tk/struts.h"
 
 typedef struct tk_options {
-    double radius;               /* tube radius; the diameter tau is 2 radius */
+    double radius;               /* tube radius in [1e-30, 1e30] (the range of
+                                  * tk_curve_check_range); the diameter tau is 2 radius */
     double lambda;               /* stiffness: minrad >= lambda * radius */
     double resolution;           /* re-resolve to ceil(resolution * ropelength)
                                     vertices at the start; 0 keeps the input */

@@ -107,6 +107,44 @@ describe('malformed VECT gets 422 naming its line', () => {
     });
 });
 
+describe("magnitudes outside the engine's range get 422, in time bounded by the input", () => {
+    // Squared distances of such curves overflow; the contact search once
+    // widened its radius forever on the request thread, and two such
+    // requests took the service down.
+    const HUGE = 'VECT\n1 3 0\n-3\n0\n0 0 0\n1 0 0\n0 1e200 0\n';
+    const timeout = 20000;
+
+    test('a coordinate of 1e200: 422 naming the vertex and the range', async () => {
+        for (const q of ['steps=5', 'steps=5&autoscale=true', 'steps=5&resolution=2&autoscale=true']) {
+            const r = await d.post(`/v1/jobs?${q}`, HUGE, { type: 'text/plain', timeout });
+            assert.equal(r.status, 422, `${q}: ${r.text}`);
+            assert.match(r.json.detail, /vertex 2 has coordinate y = 1e\+200, beyond the \+-1e\+30/, q);
+        }
+    });
+
+    test('a radius of 1e300 with autoscale: 422 naming the option (JSON and query)', async () => {
+        const r = await d.post('/v1/jobs', { vect: TRIANGLE, options: { radius: 1e300, autoscale: true } },
+            { timeout });
+        assert.equal(r.status, 422, r.text);
+        assert.equal(r.json.option, 'radius');
+        const q = await d.post('/v1/jobs?radius=1e300&autoscale=true', TRIANGLE, { type: 'text/plain', timeout });
+        assert.equal(q.status, 422, q.text);
+        assert.equal(q.json.option, 'radius');
+    });
+
+    test('a radius in range that autoscales the curve out of it: 422 saying so', async () => {
+        const r = await d.post('/v1/jobs', { vect: TRIANGLE, options: { radius: 1e30, autoscale: true } },
+            { timeout });
+        assert.equal(r.status, 422, r.text);
+        assert.match(r.json.detail, /autoscale to radius 1e\+30/);
+    });
+
+    test('the service still answers', async () => {
+        const h = await d.get('/v1/health', { timeout: 5000 });
+        assert.equal(h.status, 200);
+    });
+});
+
 // Sends a body with chunked transfer encoding (no Content-Length).
 function postChunked(path, type, chunks) {
     return new Promise((resolve, reject) => {

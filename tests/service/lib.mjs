@@ -143,6 +143,8 @@ export async function request(base, method, path, opts = {}) {
     }
     if (opts.type) headers['content-type'] = opts.type;
     const init = { method, headers, body };
+    // a hang fails the test instead of stalling the suite
+    if (opts.timeout) init.signal = AbortSignal.timeout(opts.timeout);
     if (body instanceof ReadableStream) init.duplex = 'half';
     const t0 = performance.now();
     const res = await fetch(new URL(path, base), init);
