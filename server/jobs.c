@@ -36,6 +36,8 @@ struct tk_jobs {
     bool stopping;
     worker_slot *slots;
     size_t nslots;
+    size_t ready;         /* workers named and scheduled (see started) */
+    pthread_cond_t started;
     atomic_ullong steps_total;
 };
 
@@ -509,6 +511,10 @@ static void *worker_main(void *arg)
     worker_slot *slot = arg;
     tk_jobs *j = slot->owner;
     set_worker_priority(j->cfg.priority);
+    pthread_mutex_lock(&j->lock);
+    j->ready++;
+    pthread_cond_signal(&j->started);
+    pthread_mutex_unlock(&j->lock);
     for (;;) {
         pthread_mutex_lock(&j->lock);
         while (!j->stopping && j->queue_len == 0)
@@ -553,6 +559,7 @@ int tk_jobs_start(tk_store *store, const tk_jobs_config *cfg, tk_jobs **out, tk_
     j->cfg = *cfg;
     pthread_mutex_init(&j->lock, NULL);
     pthread_cond_init(&j->wake, NULL);
+    pthread_cond_init(&j->started, NULL);
     atomic_init(&j->steps_total, 0);
     int64_t *ids = NULL;
     size_t n = 0;
@@ -571,6 +578,12 @@ int tk_jobs_start(tk_store *store, const tk_jobs_config *cfg, tk_jobs **out, tk_
         else
             j->nslots++;
     }
+    /* The pool is up when every worker has its name and priority, so that
+     * whoever sees the service answer sees its threads as they stay. */
+    pthread_mutex_lock(&j->lock);
+    while (j->ready < j->nslots)
+        pthread_cond_wait(&j->started, &j->lock);
+    pthread_mutex_unlock(&j->lock);
     if (rc) {
         tk_jobs_stop(&j);
         return rc;
@@ -594,6 +607,7 @@ void tk_jobs_stop(tk_jobs **p)
     for (size_t i = 0; i < j->nslots; i++)
         pthread_join(j->slots[i].thread, NULL);
     pthread_cond_destroy(&j->wake);
+    pthread_cond_destroy(&j->started);
     pthread_mutex_destroy(&j->lock);
     free(j->slots);
     free(j->queue);
