@@ -30,6 +30,14 @@
 #define COARSEST_RESOLUTION 2.5
 #define MAX_COARSE_LEVELS 3
 #define MAX_HALVINGS 50
+/* The largest ropelength a run starts from.  Autoscaled, such a curve's
+ * coordinates reach about this many diameters, and rounding then moves
+ * them by 1e-16 of that: beyond 1e9 the rounding approaches the
+ * tolerances of the step control (1e-5 of the diameter) and error
+ * recovery fails.  Curves that thin have (nearly) crossed themselves: a
+ * spline through a polygon with a spike loops through the polygon (a
+ * 16-gon with one vertex pulled out: ropelength 48, resampled 1e17). */
+#define START_ROPELENGTH_MAX 1e9
 #define MAX_CORRECTIONS 25
 #define MAX_EXPANSIONS 8
 #define HALVINGS_BEFORE_EXPANDING 3
@@ -203,6 +211,11 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
     if (rc)
         return rc;
     r->start_ropelength = m.ropelength;
+    if (!(m.ropelength <= START_ROPELENGTH_MAX))
+        return tk_error_set(err, TK_EINVAL,
+                            "the curve is too thin for its length to tighten in double "
+                            "precision: ropelength %.6g, above %g (does it nearly cross itself?)",
+                            m.ropelength, START_ROPELENGTH_MAX);
     if (r->opt.resolution > 0.0) {
         double want = ceil(r->opt.resolution * m.ropelength);
         if (want > 1e7)
@@ -222,6 +235,14 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
         tk_curve_free(&r->curve);
         r->curve = resampled;
         rc = measure(r->curve, &m, err);
+        if (rc == TK_EINVAL || (rc == TK_OK && !(m.ropelength <= START_ROPELENGTH_MAX)))
+            return tk_error_set(err, TK_EINVAL,
+                                "resampling to %zu vertices (resolution %g) makes the curve "
+                                "(nearly) cross itself (ropelength %.6g, from %.6g): the smooth "
+                                "curve through the vertices loops where they turn sharply; "
+                                "tighten without a resolution first, or add vertices there",
+                                r->curve->nvert, r->opt.resolution, rc ? INFINITY : m.ropelength,
+                                r->start_ropelength);
         if (rc)
             return rc;
     }

@@ -75,7 +75,11 @@ static void skip_space_and_comments(lexer *lx)
         } else if (is_space(ch)) {
             lx->pos++;
         } else if (ch == '#') {
-            while (lx->pos < lx->len && lx->s[lx->pos] != '\n' && lx->s[lx->pos] != '\r')
+            /* A NUL ends a comment and starts a token, so that it is
+             * refused as binary data on its line: no text file holds
+             * one, and a store of C strings would cut the text there. */
+            while (lx->pos < lx->len && lx->s[lx->pos] != '\n' && lx->s[lx->pos] != '\r' &&
+                   lx->s[lx->pos] != '\0')
                 lx->pos++;
         } else {
             break;

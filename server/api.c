@@ -596,7 +596,10 @@ static mhd_result submit(tk_api *a, struct MHD_Connection *c, const char *name,
         return send_problem_ext(a, c, atomic_load(&a->refusing) ? 503 : 429, NULL, headers, "%s",
                                 err.message);
     }
-    if (rc == TK_EINVAL || rc == TK_ELIMIT || rc == TK_EPARSE)
+    /* The submission starts a run to see that one can start: when the
+     * engine cannot make the start feasible (TK_ENUMERIC), that is this
+     * input's doing, not a fault of the service. */
+    if (rc == TK_EINVAL || rc == TK_ELIMIT || rc == TK_EPARSE || rc == TK_ENUMERIC)
         return send_input_error(a, c, &err, NULL);
     if (rc)
         return send_problem(a, c, 500, "%s", err.message);
@@ -744,8 +747,12 @@ static mhd_result get_static(tk_api *a, struct MHD_Connection *c, const char *ur
     if (!a->web)
         return send_problem(a, c, 404, "no page here: this server was started without --web");
     const char *rel = strcmp(url, "/") == 0 ? "/index.html" : url;
-    /* plain names only: no parent steps, no hidden files */
-    if (strstr(rel, "/.") || strstr(rel, "..") || strchr(rel, '\\') || strlen(rel) > 512)
+    /* Plain names below the root only: the path must start with its own
+     * separator (the root is joined to it as a directory, so ".bak/x" never
+     * reaches a neighbour "web.bak"), with no parent steps and no hidden
+     * files. */
+    if (rel[0] != '/' || strstr(rel, "/.") || strstr(rel, "..") || strchr(rel, '\\') ||
+        strlen(rel) > 512)
         return send_problem(a, c, 404, "no such file");
     char path[1200];
     snprintf(path, sizeof path, "%s%s", a->web, rel);

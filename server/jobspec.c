@@ -146,8 +146,12 @@ int tk_job_options_from_json(tk_job_options *o, const json_t *obj, const char **
                 rc = tk_error_set(err, TK_EINVAL, "option '%s': expected true or false", name);
         } else if (kind_of(name) == KIND_COUNT) {
             double x = json_number_value(value);
-            if (!json_is_number(value) || x != floor(x) || fabs(x) > (double)LLONG_MAX)
+            /* The domain is checked on the double: converting one at or
+             * above 2^63 to long long is undefined. */
+            if (!json_is_number(value) || x != floor(x))
                 rc = tk_error_set(err, TK_EINVAL, "option '%s': expected a whole number", name);
+            else if (!(x >= 0.0 && x <= (double)MAX_COUNT))
+                rc = set_count(o, name, -1, err);
             else
                 rc = set_count(o, name, (long long)x, err);
         } else {

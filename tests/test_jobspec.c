@@ -70,10 +70,15 @@ END_TEST
 
 START_TEST(bad_json_points_at_the_option)
 {
+    /* 2^63 and beyond as counts: converting them to an integer type is
+     * undefined (the sanitizer build traps), so the domain comes first. */
     const char *docs[] = {"{\"radius\": \"big\"}", "{\"steps\": 2.5}", "{\"autoscale\": 1}",
-                          "{\"lambda\": -1}", "{\"colour\": 3}", "{\"every\": true}"};
-    const char *names[] = {"radius", "steps", "autoscale", "lambda", "colour", "every"};
-    for (size_t i = 0; i < 6; i++) {
+                          "{\"lambda\": -1}", "{\"colour\": 3}", "{\"every\": true}",
+                          "{\"steps\": 9.223372036854775808e18}", "{\"every\": -9.3e18}",
+                          "{\"steps\": 1e300}", "{\"radius\": 1e300}"};
+    const char *names[] = {"radius", "steps", "autoscale", "lambda", "colour", "every",
+                           "steps", "every", "steps", "radius"};
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
         json_t *d = json_loads(docs[i], 0, NULL);
         tk_job_options o = TK_JOB_OPTIONS_INIT;
         const char *bad = NULL;

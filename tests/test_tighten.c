@@ -398,6 +398,51 @@ START_TEST(radius_out_of_the_range_is_refused)
 }
 END_TEST
 
+START_TEST(resampling_that_crosses_the_curve_is_refused)
+{
+    /* A regular 16-gon of radius 10 with one vertex pulled out to 28: the
+     * spline through it loops past the spike through the polygon, and the
+     * run once started from that curve (ropelength 1e17) or failed in
+     * error recovery ("violated by 0.75 of the diameter"), a 500. */
+    tk_curve *c = tkt_regular_polygon(16, 10.0);
+    double *spike = tk_curve_vertex(c, 14);
+    for (int k = 0; k < 3; k++)
+        spike[k] *= 2.8;
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.max_steps = 3;
+    tk_run *run = NULL;
+    tk_error err;
+    const double resolutions[] = {1, 2, 5};
+    for (size_t k = 0; k < 3; k++) {
+        o.resolution = resolutions[k];
+        ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_EINVAL);
+        ck_assert_msg(strstr(err.message, "(nearly) cross itself"), "%s", err.message);
+        ck_assert(run == NULL);
+    }
+    /* The polygon itself is thick enough and runs. */
+    o.resolution = 0.0;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    tk_stop_reason why;
+    ck_assert_int_eq(tk_run_until(run, &why, &err), TK_OK);
+    ck_assert(tk_run_latest(run)->thickness >= 1.0 * (1 - o.overstep_tolerance));
+    tk_run_free(&run);
+    tk_curve_free(&c);
+    /* Too thin to tighten in double precision, without resampling: the
+     * top vertex of a 16-gon pulled down to 1e-9 above the bottom one
+     * (ropelength about 3e11). */
+    c = tkt_regular_polygon(16, 10.0);
+    double *top = tk_curve_vertex(c, 4);
+    const double *bottom = tk_curve_vertex(c, 12);
+    top[0] = bottom[0];
+    top[1] = bottom[1] + 1e-9;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_EINVAL);
+    ck_assert_msg(strstr(err.message, "too thin for its length") && strstr(err.message, "1e+09"),
+                  "%s", err.message);
+    tk_curve_free(&c);
+}
+END_TEST
+
 typedef struct cancel_case {
     tk_run *run;
     long steps_at_cancel;
@@ -605,6 +650,7 @@ int main(void)
     TCase *range = tcase_create("range");
     tcase_set_timeout(range, 30);
     tcase_add_test(range, radius_out_of_the_range_is_refused);
+    tcase_add_test(range, resampling_that_crosses_the_curve_is_refused);
     suite_add_tcase(s, range);
     return tkt_run_suite(s);
 }

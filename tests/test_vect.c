@@ -680,6 +680,14 @@ START_TEST(test_binary_garbage)
     expect_fail_len(high, sizeof high - 1, NULL, TK_EPARSE, 7, "found '\\xff\\xfe'");
     static const char nulhead[] = "\0VECT\n1 3 0\n";
     expect_fail_len(nulhead, sizeof nulhead - 1, NULL, TK_EPARSE, 1, "binary data");
+    /* A NUL in a comment: once skipped with the comment, so that a store
+     * keeping C strings cut the text there and the job failed later. */
+    static const char nulcomment[] = "VECT\n1 3 0 # a \0 NUL\n-3\n0\n0 0 0\n1 0 0\n0 1 0\n";
+    expect_fail_len(nulcomment, sizeof nulcomment - 1, NULL, TK_EPARSE, 2, "binary data '\\x00'");
+    static const char nultail[] = "VECT\n1 3 0\n-3\n0\n0 0 0\n1 0 0\n0 1 0\n# end\0\n";
+    expect_fail_len(nultail, sizeof nultail - 1, NULL, TK_EPARSE, 8, "binary data");
+    static const char nulfirst[] = "# \0\nVECT\n1 3 0\n-3\n0\n0 0 0\n1 0 0\n0 1 0\n";
+    expect_fail_len(nulfirst, sizeof nulfirst - 1, NULL, TK_EPARSE, 1, "binary data");
 
     /* Random bytes: always an error, with a line, never a crash. */
     tkt_rng rng = {7};

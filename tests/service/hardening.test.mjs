@@ -1,0 +1,121 @@
+// What a hostile client probe found, each answered now: the page's files
+// never leave the web root (not even into a neighbour whose name starts
+// with the root's), NUL bytes are refused on their line, and a start the
+// engine cannot tighten is a 422, not a 500.
+
+import assert from 'node:assert/strict';
+import { mkdirSync, writeFileSync } from 'node:fs';
+import { connect } from 'node:net';
+import { join } from 'node:path';
+import { after, before, describe, test } from 'node:test';
+
+import { startDaemon, submit, tempDir, waitFinal } from './lib.mjs';
+
+// Sends `head` (a request line and headers, CRLF included) as raw bytes, so
+// that paths reach the daemon exactly as written; resolves to the status,
+// the headers as one string, and the body.
+function raw(port, head) {
+    return new Promise((resolve, reject) => {
+        const s = connect(port, '127.0.0.1');
+        let data = '';
+        s.setEncoding('latin1');
+        s.setTimeout(10000, () => {
+            s.destroy();
+            reject(new Error(`no answer in 10 s to ${JSON.stringify(head.slice(0, 80))}`));
+        });
+        s.on('data', (d) => (data += d));
+        s.on('error', reject);
+        s.on('end', () => {
+            const m = /^HTTP\/1\.[01] (\d{3})/.exec(data);
+            const split = data.indexOf('\r\n\r\n');
+            resolve({
+                status: m ? Number(m[1]) : 0,
+                headers: split >= 0 ? data.slice(0, split) : data,
+                body: split >= 0 ? data.slice(split + 4) : '',
+            });
+        });
+        s.write(head);
+    });
+}
+
+describe('the page\'s files stay inside the web root', () => {
+    let d;
+    const SECRET = 'the secret that must not leave';
+    before(async () => {
+        const top = tempDir('web');
+        const web = join(top, 'web');
+        mkdirSync(join(web, 'sub'), { recursive: true });
+        writeFileSync(join(web, 'index.html'), '<!doctype html><title>page</title>\n');
+        writeFileSync(join(web, 'sub', 'a.txt'), 'inside\n');
+        writeFileSync(join(web, '.hidden'), SECRET);
+        for (const neighbour of ['web.bak', 'web-private', 'webx'])
+            mkdirSync(join(top, neighbour));
+        writeFileSync(join(top, 'web.bak', 'secret.txt'), SECRET);
+        writeFileSync(join(top, 'web-private', 'x'), SECRET);
+        writeFileSync(join(top, 'webx', 'index.html'), SECRET);
+        writeFileSync(join(top, 'secret.txt'), SECRET);
+        d = await startDaemon({ workers: 1, args: ['--web', web] });
+    });
+    after(async () => d && (await d.stop()));
+
+    test('files inside are served', async () => {
+        for (const [path, text] of [['/', 'page'], ['/index.html', 'page'], ['/sub/a.txt', 'inside']]) {
+            const r = await raw(d.port, `GET ${path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n`);
+            assert.equal(r.status, 200, path);
+            assert.ok(r.body.includes(text), path);
+        }
+    });
+
+    // The first three once served the neighbours' files: the root was
+    // joined to a path without a leading slash.
+    const ESCAPES = ['.bak/secret.txt', '-private/x', 'x/index.html', '../secret.txt', '/../secret.txt',
+        '/../web.bak/secret.txt', '/%2e%2e/secret.txt', '/%2E%2E/web.bak/secret.txt', '/..%2fsecret.txt',
+        '/sub/../../secret.txt', '/sub/%2e%2e/%2e%2e/secret.txt', '/.hidden', '/%2ehidden', '/sub/..',
+        '//../secret.txt', '/..\\secret.txt', '/sub\\..\\..\\secret.txt', '*', 'secret.txt',
+        '/index.html/../../secret.txt'];
+    test(`${ESCAPES.length} ways out are refused with a problem, and none shows the secret`, async () => {
+        for (const path of ESCAPES) {
+            const r = await raw(d.port, `GET ${path} HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n`);
+            assert.ok(!r.body.includes(SECRET), `${path} served a file outside the root`);
+            assert.ok(r.status >= 400 && r.status < 500, `${path}: status ${r.status}`);
+        }
+    });
+});
+
+describe('inputs once accepted or answered 500', () => {
+    let d;
+    before(async () => {
+        d = await startDaemon({ workers: 1 });
+    });
+    after(async () => d && (await d.stop()));
+
+    test('a NUL byte in a comment: 422 naming its line (text/plain), 400 as JSON', async () => {
+        const text = 'VECT\n1 3 0 # a \0 NUL\n-3\n0\n0 0 0\n1 0 0\n0 1 0\n';
+        const r = await d.post('/v1/jobs?autoscale=true', Buffer.from(text, 'latin1'), { type: 'text/plain' });
+        assert.equal(r.status, 422, r.text);
+        assert.equal(r.json.line, 2);
+        // JSON's reader refuses \u0000 in any string before the VECT reader sees it
+        const j = await d.post('/v1/jobs', { vect: text, options: { autoscale: true } });
+        assert.equal(j.status, 400, j.text);
+        assert.match(j.json.detail, /\\u0000/);
+        assert.equal((await d.get('/v1/jobs')).json.total, 0, 'nothing stored');
+    });
+
+    test('a spike whose resampled spline crosses the polygon: 422 saying so; without resampling it runs', async () => {
+        // a 16-gon of radius 10 with vertex 14 pulled out to radius 28
+        const rows = [];
+        for (let k = 0; k < 16; k++) {
+            const a = (2 * Math.PI * k) / 16, r = k === 14 ? 28 : 10;
+            rows.push(`${r * Math.cos(a)} ${r * Math.sin(a)} 0`);
+        }
+        const spike = `VECT\n1 16 0\n-16\n0\n${rows.join('\n')}\n`;
+        for (const q of ['resolution=1', 'resolution=2', 'resolution=5']) {
+            const r = await d.post(`/v1/jobs?steps=5&autoscale=true&${q}`, spike, { type: 'text/plain' });
+            assert.equal(r.status, 422, `${q}: ${r.text}`);
+            assert.match(r.json.detail, /\(nearly\) cross itself/, q);
+        }
+        const job = await waitFinal(d, (await submit(d, spike, { query: 'steps=5&autoscale=true' })).id);
+        assert.equal(job.state, 'done');
+        assert.ok(job.thickness >= 1 - 1e-5, `thickness ${job.thickness}`);
+    });
+});
