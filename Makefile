@@ -5,6 +5,7 @@
 #                   under address+undefined sanitizers)
 #   make run        build and start the service
 #   make bench      run the benchmarks (print figures, never fail on time)
+#   make fuzz       run each fuzz target FUZZ_SECONDS (default 60) with libFuzzer
 #   make deps       install missing Debian packages (quiet when all there)
 #   V=1             show full commands; SANITIZE=1 builds into build/asan
 #   CC=clang        any C11 compiler
@@ -14,7 +15,14 @@ BUILD ?= build
 SHARED ?= ../shared
 CATALOGUE ?= $(SHARED)/catalogue
 
-ifeq ($(SANITIZE),1)
+ifeq ($(FUZZ),1)
+# libFuzzer's coverage in every object; the targets link -fsanitize=fuzzer.
+BUILD := build/libfuzzer
+CC := clang
+SAN_FLAGS := -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer \
+	-fno-sanitize-recover=all
+OPT := -O1
+else ifeq ($(SANITIZE),1)
 BUILD := build/asan
 SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 OPT := -O1
@@ -56,13 +64,20 @@ TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 TEST_SUPPORT_SRC := $(wildcard tests/support/*.c)
 TEST_SUPPORT_OBJ := $(TEST_SUPPORT_SRC:%.c=$(BUILD)/%.o)
 
+# Fuzz targets (tests/fuzz/fuzz_NAME.c): libFuzzer binaries with `make fuzz`,
+# and replay drivers that run their corpora in every `make test`.
+FUZZ_TARGETS := $(patsubst tests/fuzz/fuzz_%.c,%,$(wildcard tests/fuzz/fuzz_*.c))
+REPLAY_BIN := $(FUZZ_TARGETS:%=$(BUILD)/fuzz/replay_%)
+FUZZ_BIN := $(FUZZ_TARGETS:%=$(BUILD)/fuzz/fuzz_%)
+FUZZ_SECONDS ?= 60
+
 BENCH_SRC := $(wildcard bench/*.c)
 BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
 .SECONDARY:
 
 .PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-service \
-	lint headers clean
+	lint headers clean fuzz fuzz-bin
 
 WEB_OUT := $(BUILD)/web
 WEB_SRC := $(wildcard web/*)
@@ -72,8 +87,17 @@ all: $(LIB) $(CLI) $(DAEMON) $(WEB_OUT)/index.html
 deps:
 	$(Q)./tools/install-deps.sh
 	$(Q)./tools/install-node-deps.sh
+	@mkdir -p build && touch $(DEPS_STAMP)
 
-$(BUILD)/%.o: %.c
+# Plain `make` on a fresh clone installs what the build needs first (once;
+# `make deps` checks again).
+DEPS_STAMP := build/.deps-installed
+$(DEPS_STAMP): tools/install-deps.sh tools/install-node-deps.sh package-lock.json
+	$(Q)./tools/install-deps.sh
+	$(Q)./tools/install-node-deps.sh
+	@mkdir -p build && touch $@
+
+$(BUILD)/%.o: %.c | $(DEPS_STAMP)
 	@mkdir -p $(dir $@)
 	@$(if $(Q),echo "  CC      $<")
 	$(Q)$(CC) $(CPPFLAGS) $(CFLAGS) $(CHECK_CFLAGS) -c -o $@ $<
@@ -83,7 +107,7 @@ $(LIB): $(ENGINE_OBJ)
 	$(Q)rm -f $@ && ar rcs $@ $^
 
 # The page: web/ and the three.js modules from node_modules (make deps).
-$(WEB_OUT)/index.html: $(WEB_SRC) tools/build-web.sh package-lock.json
+$(WEB_OUT)/index.html: $(WEB_SRC) tools/build-web.sh package-lock.json | $(DEPS_STAMP)
 	@$(if $(Q),echo "  WEB     $(WEB_OUT)")
 	$(Q)./tools/build-web.sh $(WEB_OUT) >/dev/null
 
@@ -104,6 +128,17 @@ $(BUILD)/tests/%: $(BUILD)/tests/%.o $(TEST_SUPPORT_OBJ) $(SERVER_LIB) $(LIB)
 	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(SERVER_LIB) $(LIB) $(CHECK_LIBS) \
 		$(SERVER_LIBS) $(LDLIBS)
 
+$(BUILD)/fuzz/replay_%: $(BUILD)/tests/fuzz/fuzz_%.o $(BUILD)/tests/fuzz/replay.o $(SERVER_LIB) $(LIB)
+	@mkdir -p $(dir $@)
+	@$(if $(Q),echo "  LD      $@")
+	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(BUILD)/tests/fuzz/replay.o $(SERVER_LIB) $(LIB) \
+		$(SERVER_LIBS) $(LDLIBS)
+
+$(BUILD)/fuzz/fuzz_%: $(BUILD)/tests/fuzz/fuzz_%.o $(SERVER_LIB) $(LIB)
+	@mkdir -p $(dir $@)
+	@$(if $(Q),echo "  LD      $@")
+	$(Q)$(CC) $(LDFLAGS) -fsanitize=fuzzer -o $@ $< $(SERVER_LIB) $(LIB) $(SERVER_LIBS) $(LDLIBS)
+
 $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIB)
 	@$(if $(Q),echo "  LD      $@")
 	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(LIB) $(LDLIBS)
@@ -111,11 +146,20 @@ $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIB)
 # Every test: unit tests in the normal and sanitizer builds, then the
 # command-line tests; one closing line with the totals.
 test: deps
-	$(Q)$(MAKE) --no-print-directory all $(TEST_BIN)
+	$(Q)$(MAKE) --no-print-directory all tests-bin
 	$(Q)$(MAKE) --no-print-directory SANITIZE=1 all tests-bin
 	$(Q)./tests/run-all.sh $(BUILD) build/asan $(CATALOGUE)
 
-tests-bin: $(TEST_BIN)
+tests-bin: $(TEST_BIN) $(REPLAY_BIN)
+
+# Each fuzz target for FUZZ_SECONDS (default 60) with clang's libFuzzer,
+# from its seed corpus tests/fuzz/corpus/NAME; what it finds is kept in
+# build/libfuzzer/corpus/NAME, crashes in build/libfuzzer/artifacts.
+fuzz: deps
+	$(Q)$(MAKE) --no-print-directory FUZZ=1 fuzz-bin
+	$(Q)./tests/fuzz/fuzz.sh build/libfuzzer $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+
+fuzz-bin: $(FUZZ_BIN)
 
 test-unit: all $(TEST_BIN)
 	$(Q)./tests/run-all.sh --unit-only $(BUILD) "" $(CATALOGUE)
@@ -157,4 +201,4 @@ clean:
 	rm -rf build
 
 -include $(ENGINE_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(BUILD)/server/tightknotd.d $(CLI_OBJ:.o=.d) $(TEST_BIN:%=%.d) $(TEST_SUPPORT_OBJ:.o=.d) \
-	$(BENCH_BIN:%=%.d)
+	$(BENCH_BIN:%=%.d) $(FUZZ_TARGETS:%=$(BUILD)/tests/fuzz/fuzz_%.d) $(BUILD)/tests/fuzz/replay.d

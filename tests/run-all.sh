@@ -52,7 +52,8 @@ for dir in "$build" $asan; do
 done
 
 # The command-line tests (tests/cli-*.sh) and the suites in directories
-# (tests/*/run.sh: the service's API, the page in a browser) all end with
+# (tests/*/run.sh: the service's API, the page in a browser, the fuzz
+# corpora replayed in both builds) all end with
 # "NAME: N passed, M failed".
 # The service's suite runs a second time against the sanitizer build's
 # daemon and command line.
@@ -63,8 +64,8 @@ if [ "$unit_only" -eq 0 ]; then
         dir=$build
         case "$t" in asan:*) dir=$asan; t=${t#asan:} ;; esac
         [ -f "$t" ] || continue
-        TK_BUILD=$dir TK_DAEMON=$dir/tightknotd TK_CLI=$dir/tightknot TK_WEB=$dir/web \
-            sh "$t" >"$log" 2>&1
+        TK_BUILD=$dir TK_ASAN_BUILD=$asan TK_DAEMON=$dir/tightknotd TK_CLI=$dir/tightknot \
+            TK_WEB=$dir/web sh "$t" >"$log" 2>&1
         line=$(grep -E '^[a-z-]+: [0-9]+ passed, [0-9]+ failed' "$log" | tail -n 1)
         if [ -z "$line" ]; then
             failed=$((failed + 1)); echo "FAIL $t: no summary"; tail -n 20 "$log"; continue

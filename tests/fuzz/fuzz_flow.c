@@ -1,0 +1,99 @@
+/* Fuzz target: a few steps of the flow on tiny fuzzed curves.
+ *
+ * The bytes are a curve: the first picks one or two components, the
+ * next one per component its vertex count (4 to 19), then each
+ * coordinate is a signed 16-bit integer / 4096 (a box of side 16).  A
+ * valid curve is autoscaled and tightened for a few steps; after every
+ * step the thickness must hold the diameter within the overstep
+ * tolerance (the flow's promise, section 4.5), and the figures must be
+ * finite.  An error must be a clean one with a message, and it leaves
+ * the last good curve, which must hold the diameter too. */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tk/thickness.h"
+#include "tk/tighten.h"
+
+#define CHECK(cond)                                                                      \
+    do {                                                                                 \
+        if (!(cond)) {                                                                   \
+            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);    \
+            abort();                                                                     \
+        }                                                                                \
+    } while (0)
+
+typedef struct reader {
+    const uint8_t *p;
+    size_t n, at;
+} reader;
+
+static unsigned next_byte(reader *r)
+{
+    return r->at < r->n ? r->p[r->at++] : 0u;
+}
+
+static double next_coordinate(reader *r)
+{
+    unsigned hi = next_byte(r), lo = next_byte(r);
+    int16_t v = (int16_t)(uint16_t)((hi << 8) | lo);
+    return (double)v / 4096.0;
+}
+
+static int check_step(const tk_step_report *s, void *user)
+{
+    const tk_options *o = user;
+    double tau = 2.0 * o->radius;
+    if (!(s->thickness >= tau * (1.0 - o->overstep_tolerance))) {
+        fprintf(stderr, "step %ld: thickness %.17g below the diameter %.17g\n", s->step,
+                s->thickness, tau);
+        abort();
+    }
+    CHECK(isfinite(s->ropelength) && s->ropelength > 0.0);
+    CHECK(isfinite(s->length) && s->length > 0.0);
+    return 0;
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    reader rd = {data, size, 0};
+    size_t ncomp = 1 + next_byte(&rd) % 2;
+    size_t counts[2];
+    bool closed[2] = {true, true};
+    for (size_t k = 0; k < ncomp; k++)
+        counts[k] = 4 + next_byte(&rd) % 16;
+    tk_curve *c = NULL;
+    CHECK(tk_curve_new(&c, ncomp, counts, closed, NULL) == TK_OK);
+    for (size_t i = 0; i < 3 * c->nvert; i++)
+        c->xyz[i] = next_coordinate(&rd);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.max_steps = 6;
+    o.max_seconds = 2.0;
+    tk_run *run = NULL;
+    tk_error err;
+    int rc = tk_run_new(c, &o, &run, &err);
+    if (rc != TK_OK) {
+        CHECK(rc == TK_EINVAL || rc == TK_ENUMERIC || rc == TK_ELIMIT);
+        CHECK(err.message[0] != '\0');
+        tk_curve_free(&c);
+        return 0;
+    }
+    check_step(tk_run_latest(run), &o);
+    tk_run_set_progress(run, check_step, &o);
+    tk_stop_reason why;
+    rc = tk_run_until(run, &why, &err);
+    if (rc != TK_OK) {
+        CHECK(rc == TK_ENUMERIC && why == TK_STOP_FAILED && err.message[0] != '\0');
+        tk_measure m;
+        CHECK(tk_thickness_measure(tk_run_curve(run), NULL, &m, NULL) == TK_OK);
+        CHECK(m.thickness >= 2.0 * o.radius * (1.0 - o.overstep_tolerance));
+    }
+    tk_run_free(&run);
+    tk_curve_free(&c);
+    return 0;
+}

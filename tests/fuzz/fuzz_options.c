@@ -1,0 +1,135 @@
+/* Fuzz target: the run options by name (server/jobspec.c), the way the
+ * HTTP query, the command line and a JSON body give them.
+ *
+ * The first byte picks the form: even, the rest is "name=value" pairs
+ * separated by '&' (a query string, as the command line's --name value
+ * pairs also reach tk_job_option_set_text); odd, the rest is a JSON
+ * document for tk_job_options_from_json.  Whatever is accepted must lie
+ * in the documented domains, survive the round trip through JSON
+ * unchanged, and start a run on a small curve or be refused by the
+ * engine with a clean error. */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tk/generate.h"
+#include "tk/jobspec.h"
+#include "tk/tighten.h"
+
+#define CHECK(cond)                                                                      \
+    do {                                                                                 \
+        if (!(cond)) {                                                                   \
+            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);    \
+            abort();                                                                     \
+        }                                                                                \
+    } while (0)
+
+static int from_text(tk_job_options *o, const char *text, size_t len)
+{
+    char *copy = malloc(len + 1);
+    CHECK(copy);
+    memcpy(copy, text, len);
+    copy[len] = '\0';
+    int rc = TK_OK;
+    char *save = NULL;
+    for (char *pair = strtok_r(copy, "&", &save); pair && rc == TK_OK;
+         pair = strtok_r(NULL, "&", &save)) {
+        char *eq = strchr(pair, '=');
+        const char *value = "";
+        if (eq) {
+            *eq = '\0';
+            value = eq + 1;
+        }
+        tk_error err;
+        rc = tk_job_option_set_text(o, pair, value, &err);
+        if (rc)
+            CHECK(rc == TK_EINVAL && strstr(err.message, "option") != NULL);
+    }
+    free(copy);
+    return rc;
+}
+
+static int from_json(tk_job_options *o, const char *text, size_t len)
+{
+    json_t *doc = json_loadb(text, len, JSON_REJECT_DUPLICATES | JSON_DECODE_ANY, NULL);
+    if (!doc)
+        return TK_EPARSE;
+    const char *bad = NULL;
+    tk_error err;
+    int rc = tk_job_options_from_json(o, doc, &bad, &err);
+    if (rc)
+        CHECK(rc == TK_EINVAL && (!json_is_object(doc) || bad != NULL));
+    json_decref(doc);
+    return rc;
+}
+
+static void check_domains(const tk_job_options *o)
+{
+    CHECK(o->resolution >= 0.0 && o->resolution <= 1e4);
+    CHECK(o->steps >= 0 && o->steps <= 1000000000L);
+    CHECK(o->every >= 0 && o->every <= 1000000000L);
+    CHECK(o->time >= 0.0 && isfinite(o->time));
+    CHECK(o->residual >= 0.0 && isfinite(o->residual));
+    CHECK(o->radius >= 1e-30 && o->radius <= 1e30);
+    CHECK(o->lambda > 0.0 && isfinite(o->lambda));
+}
+
+static void check_round_trip(const tk_job_options *o)
+{
+    json_t *j = tk_job_options_to_json(o);
+    CHECK(j);
+    tk_job_options back = TK_JOB_OPTIONS_INIT;
+    back.autoscale = !o->autoscale; /* so that the flag must be read back */
+    tk_error err;
+    CHECK(tk_job_options_from_json(&back, j, NULL, &err) == TK_OK);
+    CHECK(back.resolution == o->resolution && back.steps == o->steps && back.time == o->time &&
+          back.residual == o->residual && back.radius == o->radius &&
+          back.lambda == o->lambda && back.autoscale == o->autoscale && back.every == o->every);
+    json_decref(j);
+}
+
+/* A run on a 24-vertex trefoil with the options, for a few steps at most:
+ * started, or refused with a clean error. */
+static void check_run(const tk_job_options *o)
+{
+    if (o->resolution > 20.0)
+        return; /* thousands of vertices: too slow for a fuzz input */
+    tk_curve *c = NULL;
+    CHECK(tk_generate_torus(2, 3, 24, &c, NULL) == TK_OK);
+    tk_options run = TK_OPTIONS_INIT;
+    tk_job_options_to_run(o, &run);
+    run.max_steps = 2;
+    run.max_seconds = 1.0;
+    tk_run *r = NULL;
+    tk_error err;
+    int rc = tk_run_new(c, &run, &r, &err);
+    if (rc == TK_OK) {
+        tk_stop_reason why;
+        rc = tk_run_until(r, &why, &err);
+        CHECK(rc == TK_OK || rc == TK_ENUMERIC);
+        tk_run_free(&r);
+    } else {
+        CHECK(rc == TK_EINVAL || rc == TK_ELIMIT || rc == TK_ENUMERIC);
+        CHECK(err.message[0] != '\0');
+    }
+    tk_curve_free(&c);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    if (size < 1 || size > 4096)
+        return 0;
+    tk_job_options o = TK_JOB_OPTIONS_INIT;
+    const char *text = (const char *)data + 1;
+    int rc = data[0] % 2 ? from_json(&o, text, size - 1) : from_text(&o, text, size - 1);
+    if (rc != TK_OK)
+        return 0;
+    check_domains(&o);
+    check_round_trip(&o);
+    check_run(&o);
+    return 0;
+}
