@@ -44,6 +44,7 @@ struct tk_api {
     tk_jobs *jobs;
     tk_store *store;
     atomic_bool refusing;
+    atomic_size_t buffered; /* bytes of request bodies held, all connections */
     atomic_ullong requests[CLASSES];
     double started;
 };
@@ -51,9 +52,19 @@ struct tk_api {
 /* Per-request state: the body as it arrives. */
 typedef struct request {
     char *body;
-    size_t len, cap;
+    size_t len, cap;     /* cap bytes are counted in tk_api.buffered */
     bool too_large;
+    bool crowded;        /* the bodies held at once reached max_body_total */
 } request;
+
+/* Gives back what a request's body held. */
+static void drop_body(tk_api *a, request *rq)
+{
+    atomic_fetch_sub(&a->buffered, rq->cap);
+    free(rq->body);
+    rq->body = NULL;
+    rq->len = rq->cap = 0;
+}
 
 typedef enum MHD_Result mhd_result;
 
@@ -268,8 +279,13 @@ static mhd_result get_health(tk_api *a, struct MHD_Connection *c)
 {
     tk_jobs_stats s;
     tk_jobs_stats_get(a->jobs, &s);
-    json_t *o = json_pack("{s:s, s:I, s:I, s:I, s:I, s:f}", "status",
-                          "ok", "workers",
+    char reason[TK_ERROR_MESSAGE_SIZE + 64];
+    /* A store that cannot take jobs makes the service unusable: a 503
+     * problem saying why, for a load balancer or a watchdog to see. */
+    if (!tk_store_health(a->store, reason, sizeof reason))
+        return send_problem_ext(a, c, 503, json_pack("{s:s}", "health", "degraded"), NULL, "%s",
+                                reason);
+    json_t *o = json_pack("{s:s, s:I, s:I, s:I, s:I, s:f}", "status", "ok", "workers",
                           (json_int_t)s.workers, "running", (json_int_t)s.running, "queued",
                           (json_int_t)s.queued, "queue_limit", (json_int_t)s.queue_limit,
                           "uptime", now_unix() - a->started);
@@ -311,6 +327,10 @@ static mhd_result get_metrics(tk_api *a, struct MHD_Connection *c)
     fprintf(f, "# HELP tightknot_steps_per_second Steps per second over the running jobs.\n"
                "# TYPE tightknot_steps_per_second gauge\ntightknot_steps_per_second %.6g\n",
             s.steps_per_second);
+    fprintf(f, "# HELP tightknot_http_body_bytes_held Bytes of request bodies held now, all "
+               "connections (at most --max-body-total).\n"
+               "# TYPE tightknot_http_body_bytes_held gauge\ntightknot_http_body_bytes_held %zu\n",
+            atomic_load(&a->buffered));
     fputs("# HELP tightknot_http_responses_total HTTP responses by status class.\n"
           "# TYPE tightknot_http_responses_total counter\n",
           f);
@@ -529,10 +549,22 @@ static mhd_result cancel_job(tk_api *a, struct MHD_Connection *c, int64_t id)
     tk_job job;
     tk_error err;
     int rc = tk_jobs_cancel(a->jobs, id, &job, &err);
+    if (rc == TK_EINVAL) {
+        /* finished: no worker touches it again, so it can go */
+        rc = tk_store_delete(a->store, id, &err);
+        if (rc == TK_OK) {
+            struct MHD_Response *r = MHD_create_response_from_buffer(0, NULL,
+                                                                     MHD_RESPMEM_PERSISTENT);
+            if (!r)
+                return MHD_NO;
+            mhd_result ret = MHD_queue_response(c, 204, r);
+            MHD_destroy_response(r);
+            atomic_fetch_add(&a->requests[CLASS_2XX], 1);
+            return ret;
+        }
+    }
     if (rc == TK_ENOTFOUND)
         return send_problem(a, c, 404, "%s", err.message);
-    if (rc == TK_EINVAL)
-        return send_problem(a, c, 409, "%s", err.message);
     if (rc)
         return send_problem(a, c, 500, "%s", err.message);
     /* a queued job is cancelled now (200); a running one stops within a
@@ -890,18 +922,29 @@ static mhd_result handle(void *cls, struct MHD_Connection *c, const char *url,
         }
         if (!rq->too_large && rq->len + *upload_data_size > a->cfg.max_body) {
             rq->too_large = true;
-            free(rq->body);
-            rq->body = NULL;
-            rq->len = rq->cap = 0;
+            drop_body(a, rq);
         }
-        if (!rq->too_large) {
+        if (!rq->too_large && !rq->crowded) {
             if (rq->len + *upload_data_size + 1 > rq->cap) {
                 size_t cap = rq->cap ? rq->cap : 65536;
                 while (cap < rq->len + *upload_data_size + 1)
                     cap *= 2;
+                /* Every body is bounded by max_body, and all of them at
+                 * once by max_body_total: held uploads cannot take the
+                 * daemon's memory, whatever their number. */
+                size_t more = cap - rq->cap;
+                if (atomic_fetch_add(&a->buffered, more) + more > a->cfg.max_body_total) {
+                    atomic_fetch_sub(&a->buffered, more);
+                    rq->crowded = true;
+                    drop_body(a, rq);
+                    *upload_data_size = 0;
+                    return MHD_YES;
+                }
                 char *grown = realloc(rq->body, cap);
-                if (!grown)
+                if (!grown) {
+                    atomic_fetch_sub(&a->buffered, more);
                     return MHD_NO;
+                }
                 rq->body = grown;
                 rq->cap = cap;
             }
@@ -920,18 +963,23 @@ answer:
     if (rq->too_large)
         return send_problem(a, c, 413, "the request body is larger than the limit of %zu bytes",
                             a->cfg.max_body);
+    if (rq->crowded) {
+        const char *headers[] = {MHD_HTTP_HEADER_RETRY_AFTER, "5", NULL};
+        return send_problem_ext(a, c, 503, NULL, headers,
+                                "too many uploads at once (%zu bytes held): try again shortly",
+                                a->cfg.max_body_total);
+    }
     return route(a, c, url, method, rq);
 }
 
 static void request_done(void *cls, struct MHD_Connection *c, void **con_cls,
                          enum MHD_RequestTerminationCode toe)
 {
-    (void)cls;
     (void)c;
     (void)toe;
     request *rq = *con_cls;
     if (rq) {
-        free(rq->body);
+        drop_body(cls, rq);
         free(rq);
         *con_cls = NULL;
     }
@@ -955,6 +1003,7 @@ int tk_api_start(const tk_api_config *cfg, tk_jobs *jobs, tk_store *store, tk_ap
     a->store = store;
     a->started = now_unix();
     atomic_init(&a->refusing, false);
+    atomic_init(&a->buffered, 0);
     for (int i = 0; i < CLASSES; i++)
         atomic_init(&a->requests[i], 0);
     if (cfg->web) {
@@ -970,6 +1019,7 @@ int tk_api_start(const tk_api_config *cfg, tk_jobs *jobs, tk_store *store, tk_ap
         MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_EPOLL, 0, NULL, NULL, handle, a,
         MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr, MHD_OPTION_THREAD_POOL_SIZE, threads,
         MHD_OPTION_CONNECTION_LIMIT, (unsigned)cfg->max_connections,
+        MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg->max_per_address,
         MHD_OPTION_CONNECTION_TIMEOUT, cfg->timeout, MHD_OPTION_NOTIFY_COMPLETED, request_done,
         a, MHD_OPTION_LISTEN_BACKLOG_SIZE, 1024, MHD_OPTION_END);
     if (!a->daemon) {

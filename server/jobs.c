@@ -205,7 +205,6 @@ typedef struct job_run {
     long *pending_steps;    /* frames taken since the last write */
     double *pending_xyz;
     size_t pending, pending_cap;
-    tk_error flush_error;
 } job_run;
 
 /* The frames of the job: stored and pending. */
@@ -224,6 +223,9 @@ static void take_frame(job_run *jr, long every, long step)
         return;
     const tk_curve *c = tk_run_curve(jr->run);
     size_t per = 3 * c->nvert;
+    size_t most = TK_JOB_MAX_FRAME_BYTES / (per * sizeof(double));
+    if (job_frames(jr) >= (most < TK_JOB_MAX_FRAMES ? most : TK_JOB_MAX_FRAMES))
+        return; /* the job's share of the store is used up */
     if (jr->pending == jr->pending_cap) {
         size_t cap = jr->pending_cap ? 2 * jr->pending_cap : 8;
         long *steps = realloc(jr->pending_steps, cap * sizeof *steps);
@@ -301,6 +303,52 @@ static int flush_job(job_run *jr, const tk_job *job, tk_error *err)
     return rc;
 }
 
+/* Whether the job's worker should let go of it (cancelled, or the service
+ * stopping). */
+static bool letting_go(job_run *jr)
+{
+    tk_jobs *j = jr->slot->owner;
+    pthread_mutex_lock(&j->lock);
+    bool go = jr->slot->cancel || j->stopping;
+    pthread_mutex_unlock(&j->lock);
+    return go;
+}
+
+/* Writes the job; while the store refuses (a full disk, a read-only
+ * file) the job pauses here, showing why, and the write is retried every
+ * second, until it succeeds or the worker must let go (then the store
+ * keeps the job as last written, which resumes at the next start).
+ * `final`: the job has ended and must not be let go of while the service
+ * runs (its end would be lost). */
+static int store_job(job_run *jr, tk_job *job, bool final)
+{
+    tk_jobs *j = jr->slot->owner;
+    tk_error err;
+    bool paused = false;
+    int rc;
+    while ((rc = flush_job(jr, job, &err)) != TK_OK) {
+        if (!paused) {
+            paused = true;
+            pthread_mutex_lock(&j->lock);
+            snprintf(jr->slot->job.error, sizeof jr->slot->job.error,
+                     "paused: storing the job failed, retrying every second: %.240s",
+                     err.message);
+            pthread_mutex_unlock(&j->lock);
+        }
+        if (final ? j->stopping : letting_go(jr))
+            break;
+        struct timespec second = {1, 0};
+        nanosleep(&second, NULL);
+    }
+    if (paused) {
+        pthread_mutex_lock(&j->lock);
+        if (rc == TK_OK)
+            jr->slot->job.error[0] = '\0';
+        pthread_mutex_unlock(&j->lock);
+    }
+    return rc;
+}
+
 static int on_step(const tk_step_report *s, void *user)
 {
     job_run *jr = user;
@@ -323,13 +371,10 @@ static int on_step(const tk_step_report *s, void *user)
     pthread_mutex_unlock(&j->lock);
     double now = now_monotonic();
     if (now - jr->last_flush >= j->cfg.flush_seconds) {
-        jr->last_flush = now;
-        /* a failed periodic write is retried at the next one; the final
-         * write reports it */
-        if (flush_job(jr, &copy, &jr->flush_error) == TK_OK)
-            tk_error_clear(&jr->flush_error);
+        store_job(jr, &copy, false);
+        jr->last_flush = now_monotonic();
     }
-    return stop;
+    return stop || letting_go(jr);
 }
 
 /* Stores the job as failed with a message. */
@@ -438,7 +483,7 @@ static void run_job(worker_slot *slot)
     pthread_mutex_lock(&j->lock);
     job = slot->job;
     pthread_mutex_unlock(&j->lock);
-    flush_job(&jr, &job, &err);
+    store_job(&jr, &job, false);
 
     tk_run_set_progress(jr.run, on_step, &jr);
     tk_stop_reason why = TK_STOP_NONE;
@@ -466,12 +511,9 @@ static void run_job(worker_slot *slot)
     }
     if (tk_job_state_final(job.state))
         job.finished = now_unix();
-    tk_error werr;
-    if (flush_job(&jr, &job, &werr) != TK_OK) {
-        job.state = TK_JOB_FAILED;
-        snprintf(job.error, sizeof job.error, "storing the result failed: %.280s", werr.message);
-        tk_store_update(j->store, &job, NULL);
-    }
+    /* The end is stored, waiting for the store if need be; a job the
+     * store still holds as running resumes at the next start. */
+    store_job(&jr, &job, true);
     tk_run_free(&jr.run);
     free(jr.hist.items);
     free(jr.pending_steps);

@@ -13,10 +13,12 @@ const char *const tk_job_option_names[] = {"resolution", "steps", "time", "resid
 /* Largest step count and interval we accept: a run of 10^9 steps is
  * already years of work, and the bound keeps every value exact in a
  * JSON double. */
-#define MAX_COUNT 1000000000L
+#define MAX_COUNT 100000000L
 /* Above this many vertices per unit ropelength the run would not fit in
  * memory for any real knot; the service also caps the vertex count. */
 #define MAX_RESOLUTION 10000.0
+/* A week: a job longer than that should be resumed as a new one. */
+#define MAX_TIME 604800.0
 
 typedef enum { KIND_REAL, KIND_COUNT, KIND_FLAG } option_kind;
 
@@ -65,6 +67,10 @@ static int set_real(tk_job_options *o, const char *name, double x, tk_error *err
                                 x, MAX_RESOLUTION);
         o->resolution = x;
     } else if (!strcmp(name, "time")) {
+        if (x > MAX_TIME)
+            return tk_error_set(err, TK_EINVAL,
+                                "option 'time': %g seconds is above the limit %g (7 days)", x,
+                                MAX_TIME);
         o->time = x;
     } else {
         o->residual = x;

@@ -6,17 +6,37 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/statvfs.h>
 
 #include <jansson.h>
 #include <sqlite3.h>
 
 #include "tk/jsonmap.h"
 
+/* Below this much free space health calls the store full: a job's save
+ * (its curve and frames) needs room beyond a page or two. */
+#define STORE_SPACE_MIN (64.0 * 1024.0)
+
 struct tk_store {
     sqlite3 *db;
     pthread_mutex_t lock;
     sqlite3_stmt *get;    /* the reads of every poll, prepared once */
+    /* Why the last write failed (a full disk, a read-only file), "" once
+     * a write succeeds again: what health reports. */
+    char write_error[TK_ERROR_MESSAGE_SIZE];
 };
+
+/* Notes the outcome of a write for tk_store_health; returns status.  Lock
+ * held. */
+static int written(tk_store *s, int status, const tk_error *err)
+{
+    if (status == TK_OK)
+        s->write_error[0] = '\0';
+    else
+        snprintf(s->write_error, sizeof s->write_error, "%s",
+                 err ? err->message : sqlite3_errmsg(s->db));
+    return status;
+}
 
 static const char *const state_names[TK_JOB_STATES] = {"queued", "running", "done", "failed",
                                                        "cancelled"};
@@ -163,6 +183,7 @@ int tk_store_insert(tk_store *s, tk_job *job, const char *vect, tk_error *err)
     else
         job->id = sqlite3_last_insert_rowid(s->db);
     sqlite3_finalize(st);
+    written(s, status, err);
     pthread_mutex_unlock(&s->lock);
     free(opts_text);
     return status;
@@ -362,7 +383,7 @@ static int update_locked(tk_store *s, const tk_job *j, tk_error *err)
 int tk_store_update(tk_store *s, const tk_job *job, tk_error *err)
 {
     pthread_mutex_lock(&s->lock);
-    int status = update_locked(s, job, err);
+    int status = written(s, update_locked(s, job, err), err);
     pthread_mutex_unlock(&s->lock);
     return status;
 }
@@ -420,7 +441,7 @@ int tk_store_save(tk_store *s, const tk_job *job, const char *curve, const char 
     pthread_mutex_lock(&s->lock);
     int status = TK_OK;
     if (sqlite3_exec(s->db, "BEGIN IMMEDIATE", NULL, NULL, NULL) != SQLITE_OK) {
-        status = db_error(s, err, "starting a transaction");
+        status = written(s, db_error(s, err, "starting a transaction"), err);
         pthread_mutex_unlock(&s->lock);
         return status;
     }
@@ -438,8 +459,76 @@ int tk_store_save(tk_store *s, const tk_job *job, const char *curve, const char 
         status = db_error(s, err, "committing");
     if (status)
         sqlite3_exec(s->db, "ROLLBACK", NULL, NULL, NULL);
+    written(s, status, err);
     pthread_mutex_unlock(&s->lock);
     return status;
+}
+
+int tk_store_delete(tk_store *s, int64_t id, tk_error *err)
+{
+    pthread_mutex_lock(&s->lock);
+    sqlite3_stmt *st = NULL;
+    int rc = sqlite3_prepare_v2(s->db, "DELETE FROM jobs WHERE id = ?", -1, &st, NULL);
+    if (rc == SQLITE_OK) {
+        sqlite3_bind_int64(st, 1, id);
+        rc = sqlite3_step(st);
+    }
+    sqlite3_finalize(st);
+    int status = rc == SQLITE_DONE ? TK_OK : db_error(s, err, "deleting a job");
+    if (!status && sqlite3_changes(s->db) == 0)
+        status = tk_error_set(err, TK_ENOTFOUND, "no job %lld", (long long)id);
+    else
+        written(s, status, err);
+    pthread_mutex_unlock(&s->lock);
+    return status;
+}
+
+bool tk_store_health(tk_store *s, char *reason, size_t size)
+{
+    pthread_mutex_lock(&s->lock);
+    bool ok = true;
+    /* The file system first: a full or read-only one fails the next
+     * write, and health should say so before a job finds out. */
+    const char *file = sqlite3_db_filename(s->db, "main");
+    char dir[4096];
+    const char *slash = file ? strrchr(file, '/') : NULL;
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - file) + 1 : 1, slash ? file : ".");
+    struct statvfs fs;
+    if (file && *file && statvfs(dir, &fs) == 0 && (fs.f_flag & ST_RDONLY)) {
+        ok = false;
+        snprintf(reason, size, "the job store's file system is read-only: jobs cannot be stored");
+    } else if (file && *file && statvfs(dir, &fs) == 0 &&
+               (double)fs.f_bavail * (double)fs.f_frsize < STORE_SPACE_MIN) {
+        ok = false;
+        snprintf(reason, size,
+                 "the job store's file system is full (%.0f KiB free): jobs cannot be stored",
+                 (double)fs.f_bavail * (double)fs.f_frsize / 1024.0);
+    } else if (sqlite3_db_readonly(s->db, "main") == 1) {
+        ok = false;
+        snprintf(reason, size, "the job store is read-only: jobs cannot be stored");
+    } else if (s->write_error[0]) {
+        ok = false;
+        snprintf(reason, size, "the last write to the job store failed: %s", s->write_error);
+    } else {
+        /* A read that walks to the newest row: a damaged file shows here
+         * as "malformed" before a client's read finds it. */
+        sqlite3_stmt *st = NULL;
+        int rc = sqlite3_prepare_v2(s->db,
+                                    "SELECT id, length(input), state FROM jobs"
+                                    " ORDER BY id DESC LIMIT 1",
+                                    -1, &st, NULL);
+        while (rc == SQLITE_OK || rc == SQLITE_ROW)
+            rc = sqlite3_step(st);
+        if (rc != SQLITE_DONE) {
+            ok = false;
+            snprintf(reason, size, "the job store cannot be read: %s", sqlite3_errmsg(s->db));
+        }
+        sqlite3_finalize(st);
+    }
+    if (ok && size)
+        reason[0] = '\0';
+    pthread_mutex_unlock(&s->lock);
+    return ok;
 }
 
 int tk_store_text(tk_store *s, int64_t id, tk_job_text which, char **out, size_t *len,

@@ -38,8 +38,13 @@ static const char usage[] =
     "  --max-vertices N     largest knot accepted, after re-resolution\n"
     "                       (default 200000)\n"
     "  --max-body BYTES     largest request body (default 16777216)\n"
+    "  --max-body-total BYTES  request bodies held at once, over all\n"
+    "                       connections; uploads beyond get 503 (default 67108864)\n"
     "  --max-connections N  open connections at once (default 1000)\n"
-    "  --timeout SECONDS    idle connections are closed after this (default 30)\n"
+    "  --max-per-address N  open connections from one client address\n"
+    "                       (default 128): one client cannot hold them all\n"
+    "  --timeout SECONDS    a connection that sends nothing for this long is\n"
+    "                       closed (default 10)\n"
     "  --http-threads N     threads answering requests (default 2)\n"
     "  --catalogue DIR      offer DIR's *.vect files at /v1/catalogue\n"
     "  --web DIR            serve the page's files from DIR at /\n"
@@ -87,7 +92,8 @@ int main(int argc, char **argv)
     const char *db = "var/tightknot.db";
     const char *catalogue_dir = NULL;
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    tk_api_config api = {"127.0.0.1", 8080, 16u << 20, 200000, 1000, 30, 2, NULL, NULL};
+    tk_api_config api = {"127.0.0.1", 8080, 16u << 20, 200000, 64u << 20, 1000, 128, 10, 2,
+                         NULL, NULL};
     tk_jobs_config jobs_cfg = TK_JOBS_CONFIG_INIT;
     jobs_cfg.workers = cores > 0 ? (size_t)cores : 1;
     jobs_cfg.max_vertices = api.max_vertices;
@@ -134,6 +140,14 @@ int main(int argc, char **argv)
             if (!parse_size(value, 64, 1ull << 32, &n))
                 return bad_usage("--max-body: '%s' must be from 64 to 4294967296", value);
             api.max_body = (size_t)n;
+        } else if (!strcmp(opt, "--max-body-total")) {
+            if (!parse_size(value, 64, 1ull << 40, &n))
+                return bad_usage("--max-body-total: '%s' must be from 64 to 1099511627776", value);
+            api.max_body_total = (size_t)n;
+        } else if (!strcmp(opt, "--max-per-address")) {
+            if (!parse_size(value, 1, 100000, &n))
+                return bad_usage("--max-per-address: '%s' must be from 1 to 100000", value);
+            api.max_per_address = (size_t)n;
         } else if (!strcmp(opt, "--max-connections")) {
             if (!parse_size(value, 1, 100000, &n))
                 return bad_usage("--max-connections: '%s' must be from 1 to 100000", value);

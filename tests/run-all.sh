@@ -1,5 +1,6 @@
 #!/bin/sh
-# Runs every test and closes with one line: "tests: N passed, M failed".
+# Runs every test and closes with one line: "tests: N passed, M failed,
+# K skipped" (suites that report skips say so; a skip is never a pass).
 #   run-all.sh [--unit-only] BUILD_DIR SANITIZER_BUILD_DIR CATALOGUE_DIR
 # Unit tests (Check, one process per test) run from both build directories;
 # the command-line, service and page tests run against BUILD_DIR's programs.
@@ -16,6 +17,7 @@ fi
 
 passed=0
 failed=0
+skipped=0
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
 
@@ -72,11 +74,13 @@ if [ "$unit_only" -eq 0 ]; then
         fi
         p=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\1/')
         f=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\2/')
-        passed=$((passed + p)); failed=$((failed + f))
+        k=$(echo "$line" | sed -nE 's/.* ([0-9]+) skipped.*/\1/p')
+        passed=$((passed + p)); failed=$((failed + f)); skipped=$((skipped + ${k:-0}))
         echo "$t ($dir): $line"
+        grep -E '^SKIP ' "$log"
         [ "$f" -eq 0 ] || grep -E '^FAIL|^not ok|^# fail|Error' "$log" | head -n 40
     done
 fi
 
-echo "tests: $passed passed, $failed failed"
+echo "tests: $passed passed, $failed failed, $skipped skipped"
 [ "$failed" -eq 0 ]

@@ -46,6 +46,8 @@ const char tk_remote_help[] =
     "      submitted again and jobs already submitted are followed.\n"
     "  status JOB...   one line per job: state, step, ropelength, residual\n"
     "  cancel JOB...   cancel queued or running jobs\n"
+    "  delete JOB...   delete finished jobs (done, failed or cancelled) from\n"
+    "                  the server, with their results\n"
     "  fetch [--out DIR] JOB...   download jobs' VECT and struts into DIR\n"
     "\n"
     "Run options (as for tightknot tighten): --resolution R, --steps N,\n"
@@ -770,8 +772,35 @@ static int cmd_jobs(client *c, const char *what, const run_args *a, bool json, i
         snprintf(path, sizeof path, "/v1/jobs/%lld", id);
         response r = {0};
         bool cancel = !strcmp(what, "cancel");
-        if (!request(c, cancel ? "DELETE" : "GET", path, NULL, NULL, 0, &r))
+        bool remove = !strcmp(what, "delete");
+        if (!request(c, "GET", path, NULL, NULL, 0, &r))
             return REMOTE_SERVER;
+        /* DELETE cancels a job that goes on and deletes one that has
+         * ended: each command does only what its name says. */
+        if ((cancel || remove) && r.status == 200) {
+            json_t *now = json_loadb(r.body.data, r.body.len, 0, NULL);
+            const char *state = json_string_value(json_object_get(now, "state"));
+            bool ended = state && strcmp(state, "queued") && strcmp(state, "running");
+            bool refuse = ended != remove;
+            if (refuse) {
+                fprintf(stderr, "tightknot remote: job %lld is %s: %s\n", id,
+                        state ? state : "?",
+                        remove ? "cancel it first" : "it has already finished (delete removes it)");
+                status = REMOTE_FAILED;
+            }
+            json_decref(now);
+            free(r.body.data);
+            memset(&r, 0, sizeof r);
+            if (refuse)
+                continue;
+            if (!request(c, "DELETE", path, NULL, NULL, 0, &r))
+                return REMOTE_SERVER;
+            if (remove && r.status == 204) {
+                printf("%lld\tdeleted\n", id);
+                free(r.body.data);
+                continue;
+            }
+        }
         if (r.status >= 400) {
             char detail[256];
             problem_text(&r, detail, sizeof detail);
@@ -887,7 +916,7 @@ int tk_remote_main(int argc, char **argv)
         }
     }
     if (status == REMOTE_OK && !command) {
-        fprintf(stderr, "tightknot remote: no COMMAND given (submit, status, cancel or fetch)\n");
+        fprintf(stderr, "tightknot remote: no COMMAND given (submit, status, cancel, delete or fetch)\n");
         status = REMOTE_USAGE;
     }
     if (status != REMOTE_OK) {
@@ -933,11 +962,11 @@ int tk_remote_main(int argc, char **argv)
     if (!strcmp(command, "submit"))
         status = cmd_submit(&c, &a, nrest, rest);
     else if (!strcmp(command, "status") || !strcmp(command, "cancel") ||
-             !strcmp(command, "fetch"))
+             !strcmp(command, "delete") || !strcmp(command, "fetch"))
         status = cmd_jobs(&c, command, &a, json, nrest, rest);
     else {
-        fprintf(stderr, "tightknot remote: unknown command '%s' (submit, status, cancel or "
-                        "fetch)\nTry 'tightknot remote --help'.\n",
+        fprintf(stderr, "tightknot remote: unknown command '%s' (submit, status, cancel, "
+                        "delete or fetch)\nTry 'tightknot remote --help'.\n",
                 command);
         status = REMOTE_USAGE;
     }

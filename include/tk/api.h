@@ -20,7 +20,10 @@ typedef struct tk_api_config {
     unsigned port;             /* 0: any free port (see tk_api_port) */
     size_t max_body;           /* request bodies beyond this get 413 */
     size_t max_vertices;       /* VECT inputs beyond this get 422 */
+    size_t max_body_total;     /* bodies held at once, all connections:
+                                  uploads beyond it get 503 */
     size_t max_connections;    /* open connections at once */
+    size_t max_per_address;    /* open connections from one client address */
     unsigned timeout;          /* seconds an idle connection is kept */
     size_t threads;            /* threads answering requests */
     const char *web;           /* directory of the page's files, or NULL */

@@ -6,6 +6,12 @@
  * poll) and are written to the store every few seconds and at the end,
  * with the curve, so that a restart takes the job up where it was.
  *
+ * When the store cannot be written (a full disk), a running job pauses:
+ * its worker retries the write every second and goes on once it
+ * succeeds; the job reads `running` with its error saying why it waits.
+ * A job is never failed for the store's sake, and a stop while paused
+ * leaves it as last stored, to resume at the next start.
+ *
  * Request handlers only call these functions; none of them runs the
  * engine's flow.
  */
@@ -43,6 +49,12 @@ typedef struct tk_jobs_config {
 
 #define TK_JOBS_CONFIG_INIT {2, TK_WORKERS_IDLE, 1000, 1000000, 2.0, 2000}
 
+/* What a job may keep of its frames: at most this many, and at most this
+ * many bytes of them (a frame of V vertices is 24 V bytes); frames due
+ * beyond either are not kept.  Bounds the store's growth per job. */
+#define TK_JOB_MAX_FRAMES 1000
+#define TK_JOB_MAX_FRAME_BYTES (256u << 20)
+
 typedef struct tk_jobs tk_jobs;
 
 /* Starts the workers; jobs the store holds as queued or running (left by
@@ -66,7 +78,8 @@ int tk_jobs_submit(tk_jobs *j, const char *name, const tk_job_options *opts,
 int tk_jobs_get(tk_jobs *j, int64_t id, tk_job *out, tk_error *err);
 
 /* Cancels a queued job at once, or asks a running one to stop (it does
- * within a step).  TK_EINVAL when the job has already finished. */
+ * within a step).  TK_EINVAL when the job has already finished (the
+ * caller may then delete it from the store: no worker touches it again). */
 int tk_jobs_cancel(tk_jobs *j, int64_t id, tk_job *out, tk_error *err);
 
 typedef struct tk_jobs_stats {

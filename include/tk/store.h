@@ -106,6 +106,15 @@ int tk_store_frames(tk_store *s, int64_t id, size_t offset, size_t limit, long *
  * restart). */
 int tk_store_unfinished(tk_store *s, int64_t **ids, size_t *n, tk_error *err);
 
+/* Removes a job with its texts and frames; TK_ENOTFOUND when there is
+ * none.  The caller sees that it is not running. */
+int tk_store_delete(tk_store *s, int64_t id, tk_error *err);
+
+/* Whether the store can take jobs: writable, its last write succeeded,
+ * and its newest job reads back.  When not, reason says why (for
+ * GET /v1/health). */
+bool tk_store_health(tk_store *s, char *reason, size_t size);
+
 /* Number of jobs in each state. */
 int tk_store_count_states(tk_store *s, size_t counts[TK_JOB_STATES], tk_error *err);
 

@@ -117,6 +117,12 @@ export function validateResponse(method, url, status, contentType, body) {
     }
     if (status >= 400)
         assert.equal(media, 'application/problem+json', `${what}: errors must be problem+json`);
+    if (status === 204) {
+        // No Content: a documented 204 has no content, and the answer none
+        assert.equal(Object.keys(content).length, 0, `${what}: a 204 documented with content`);
+        assert.equal(media, '', `${what}: a 204 with a media type`);
+        return;
+    }
     const entry = content[media];
     assert.ok(entry, `${what}: media type not documented (documented: ${Object.keys(content)})`);
     if (!media.includes('json')) return;

@@ -15,7 +15,7 @@ const running = (d, id) =>
     waitJob(d, id, (j) => j.state === 'running' && j.progress.step > 0, { what: 'running with a step taken' });
 
 describe('cancelling (--workers 1)', () => {
-    test('DELETE a queued job: 200 cancelled; a running one: 202, then cancelled; again: 409', async (t) => {
+    test('DELETE a queued job: 200 cancelled; a running one: 202, then cancelled; a finished one: 204, deleted', async (t) => {
         const d = await startDaemon({ workers: 1 });
         try {
             const a = await submit(d, LONG);
@@ -65,23 +65,25 @@ describe('cancelling (--workers 1)', () => {
             const v = await d.get(`/v1/jobs/${a.id}/vect`, { headers: { accept: 'application/json' } });
             assert.equal(v.json.step, job.progress.step);
 
-            // finished jobs cannot be cancelled again
-            for (const id of [a.id, b.id]) {
-                const again = await d.del(`/v1/jobs/${id}`);
-                assert.equal(again.status, 409, again.text);
-                assert.match(again.json.detail, /already finished/);
-            }
+            const list = await d.get('/v1/jobs?state=cancelled');
+            assert.deepEqual(list.json.jobs.map((j) => j.id), [b.id, a.id]);
+            assert.equal(list.json.total, 2);
 
             // the worker is free again
             const c = await waitFinal(d, (await submit(d, SHORT)).id);
             assert.equal(c.state, 'done');
             assert.equal(c.progress.step, 20);
-            const again = await d.del(`/v1/jobs/${c.id}`);
-            assert.equal(again.status, 409);
 
-            const list = await d.get('/v1/jobs?state=cancelled');
-            assert.deepEqual(list.json.jobs.map((j) => j.id), [b.id, a.id]);
-            assert.equal(list.json.total, 2);
+            // DELETE of a finished job removes it, with its texts and frames
+            for (const id of [a.id, b.id, c.id]) {
+                const gone = await d.del(`/v1/jobs/${id}`);
+                assert.equal(gone.status, 204, gone.text);
+                assert.equal(gone.text, '');
+                for (const part of ['', '/vect', '/struts', '/history', '/frames'])
+                    assert.equal((await d.get(`/v1/jobs/${id}${part}`)).status, 404, `${id}${part}`);
+                assert.equal((await d.del(`/v1/jobs/${id}`)).status, 404);
+            }
+            assert.equal((await d.get('/v1/jobs')).json.total, 0);
         } finally {
             await d.stop();
         }

@@ -4,8 +4,9 @@
 #   TK_DAEMON=build/tightknotd TK_CLI=build/tightknot \
 #   TK_CATALOGUE=../shared/catalogue sh tests/service/run.sh
 # Installs the node modules first when node_modules is missing or older
-# than package-lock.json.  Ends with "service: N passed, M failed" (the
-# lint counts as one test); the exit status is non-zero on any failure.
+# than package-lock.json.  Ends with "service: N passed, M failed, K
+# skipped" (the lint counts as one test); the exit status is non-zero on
+# any failure.
 set -u
 
 # paths from the environment are relative to the caller's directory
@@ -62,15 +63,17 @@ node --test \
     tests/service/*.test.mjs
 status=$?
 
-line=$(grep -E '^service: [0-9]+ passed, [0-9]+ failed$' "$summary" | tail -n 1)
+line=$(grep -E '^service: [0-9]+ passed, [0-9]+ failed, [0-9]+ skipped$' "$summary" | tail -n 1)
+skipped=0
 if [ -z "$line" ]; then
     passed=0
     failed=1
     echo "FAIL node --test gave no summary (exit status $status)"
 else
     passed=$(echo "$line" | sed -E 's/^service: ([0-9]+) passed.*/\1/')
-    failed=$(echo "$line" | sed -E 's/.* ([0-9]+) failed$/\1/')
-    grep -E '^FAIL ' "$summary"
+    failed=$(echo "$line" | sed -E 's/.* ([0-9]+) failed, .*/\1/')
+    skipped=$(echo "$line" | sed -E 's/.* ([0-9]+) skipped$/\1/')
+    grep -E '^(FAIL|SKIP) ' "$summary"
 fi
 if [ "$status" -ne 0 ] && [ "$failed" -eq 0 ]; then
     failed=1
@@ -79,5 +82,5 @@ fi
 passed=$((passed + lint_passed))
 failed=$((failed + lint_failed))
 echo "service: took $(( $(date +%s) - start )) s"
-echo "service: $passed passed, $failed failed"
+echo "service: $passed passed, $failed failed, $skipped skipped"
 [ "$failed" -eq 0 ]

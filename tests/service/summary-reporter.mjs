@@ -1,10 +1,13 @@
 // A node:test reporter that counts the tests that ran (leaves only: a
 // suite or a test with subtests is not counted again), prints "FAIL name"
-// for each failure, and ends with "service: N passed, M failed".  A test
-// file that fails outside any test counts as one failure.
+// for each failure and "SKIP name: why" for each skipped test, and ends
+// with "service: N passed, M failed, K skipped" (a skipped test is not a
+// passed one).  A test file that fails outside any test counts as one
+// failure.
 export default async function* summary(source) {
     let passed = 0;
     let failed = 0;
+    let skipped = 0;
     const childSeen = [];
     for await (const event of source) {
         if (event.type !== 'test:pass' && event.type !== 'test:fail') continue;
@@ -13,7 +16,10 @@ export default async function* summary(source) {
         childSeen[nesting + 1] = false;
         childSeen[nesting] = true;
         if (!leaf || details?.type === 'suite') continue;
-        if (event.type === 'test:pass') {
+        if (event.data.skip !== undefined && event.type === 'test:pass') {
+            skipped++;
+            yield `SKIP ${name}: ${event.data.skip === true ? 'skipped' : event.data.skip}\n`;
+        } else if (event.type === 'test:pass') {
             passed++;
         } else {
             failed++;
@@ -21,5 +27,5 @@ export default async function* summary(source) {
             yield `FAIL ${name}${where}\n`;
         }
     }
-    yield `service: ${passed} passed, ${failed} failed\n`;
+    yield `service: ${passed} passed, ${failed} failed, ${skipped} skipped\n`;
 }
