@@ -128,6 +128,9 @@ $(BUILD)/tests/%: $(BUILD)/tests/%.o $(TEST_SUPPORT_OBJ) $(SERVER_LIB) $(LIB)
 	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(SERVER_LIB) $(LIB) $(CHECK_LIBS) \
 		$(SERVER_LIBS) $(LDLIBS)
 
+# The fuzz targets see the service's own headers too (server/submission.h).
+$(BUILD)/tests/fuzz/%.o: CPPFLAGS += -Iserver
+
 $(BUILD)/fuzz/replay_%: $(BUILD)/tests/fuzz/fuzz_%.o $(BUILD)/tests/fuzz/replay.o $(SERVER_LIB) $(LIB)
 	@mkdir -p $(dir $@)
 	@$(if $(Q),echo "  LD      $@")

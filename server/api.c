@@ -14,7 +14,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -25,6 +24,8 @@
 #include "tk/jobspec.h"
 #include "tk/jsonmap.h"
 #include "tk/vect.h"
+
+#include "submission.h"
 
 #define PAGE_LIMIT_DEFAULT 50
 #define PAGE_LIMIT_MAX 500
@@ -574,38 +575,30 @@ static mhd_result cancel_job(tk_api *a, struct MHD_Connection *c, int64_t id)
 
 /* ---- submitting ---- */
 
-static bool media_is(const char *content_type, const char *media)
-{
-    if (!content_type)
-        return false;
-    size_t n = strlen(media);
-    return strncasecmp(content_type, media, n) == 0 &&
-           (content_type[n] == '\0' || content_type[n] == ';' || content_type[n] == ' ');
-}
+/* The query's parameters, in order, for tk_submission_decode. */
+typedef struct query_list {
+    tk_query_pair *pairs;
+    size_t n, cap;
+    bool failed;
+} query_list;
 
-typedef struct query_scan {
-    tk_job_options *opts;
-    const char *name;
-    tk_error err;
-    char bad[64];
-    int rc;
-} query_scan;
-
-static mhd_result scan_query(void *cls, enum MHD_ValueKind kind, const char *key,
-                             const char *value)
+static mhd_result collect_query(void *cls, enum MHD_ValueKind kind, const char *key,
+                                const char *value)
 {
     (void)kind;
-    query_scan *q = cls;
-    if (q->rc)
-        return MHD_NO;
-    if (!strcmp(key, "name")) {
-        q->name = value;
-        return MHD_YES;
+    query_list *q = cls;
+    if (q->n == q->cap) {
+        size_t cap = q->cap ? 2 * q->cap : 16;
+        tk_query_pair *grown = realloc(q->pairs, cap * sizeof *grown);
+        if (!grown) {
+            q->failed = true;
+            return MHD_NO;
+        }
+        q->pairs = grown;
+        q->cap = cap;
     }
-    q->rc = tk_job_option_set_text(q->opts, key, value ? value : "", &q->err);
-    if (q->rc)
-        snprintf(q->bad, sizeof q->bad, "%s", key);
-    return q->rc ? MHD_NO : MHD_YES;
+    q->pairs[q->n++] = (tk_query_pair){key, value};
+    return MHD_YES;
 }
 
 static mhd_result submit(tk_api *a, struct MHD_Connection *c, const char *name,
@@ -617,12 +610,10 @@ static mhd_result submit(tk_api *a, struct MHD_Connection *c, const char *name,
     tk_curve *curve = NULL;
     if (tk_vect_parse(vect, len, &limits, &curve, &err) != TK_OK)
         return send_input_error(a, c, &err, NULL);
-    char *text = strndup(vect, len);
+    /* the reader refuses a NUL anywhere, so the text is a C string */
     tk_job job;
-    int rc = text ? tk_jobs_submit(a->jobs, name, opts, curve, text, &job, &err)
-                  : tk_error_set(&err, TK_ENOMEM, "out of memory");
+    int rc = tk_jobs_submit(a->jobs, name, opts, curve, vect, &job, &err);
     tk_curve_free(&curve);
-    free(text);
     if (rc == TK_EBUSY) {
         const char *headers[] = {MHD_HTTP_HEADER_RETRY_AFTER, "30", NULL};
         return send_problem_ext(a, c, atomic_load(&a->refusing) ? 503 : 429, NULL, headers, "%s",
@@ -641,113 +632,30 @@ static mhd_result submit(tk_api *a, struct MHD_Connection *c, const char *name,
     return send_json_headers(a, c, 202, job_json(&job), "application/json", headers);
 }
 
-static bool valid_name(const char *name)
-{
-    json_t *probe = json_string(name);
-    json_decref(probe);
-    return probe && strlen(name) < TK_JOB_NAME_SIZE;
-}
-
-static mhd_result post_job_json(tk_api *a, struct MHD_Connection *c, const request *rq)
-{
-    json_error_t jerr;
-    json_t *doc = json_loadb(rq->body ? rq->body : "", rq->len, JSON_REJECT_DUPLICATES, &jerr);
-    if (!doc)
-        return send_problem(a, c, 400, "the body is not valid JSON: %s (line %d, column %d)",
-                            jerr.text, jerr.line, jerr.column);
-    mhd_result ret;
-    const char *key;
-    json_t *value;
-    if (!json_is_object(doc)) {
-        ret = send_problem(a, c, 422, "the body must be a JSON object");
-        goto done;
-    }
-    json_object_foreach(doc, key, value) {
-        if (strcmp(key, "vect") && strcmp(key, "catalogue") && strcmp(key, "name") &&
-            strcmp(key, "options")) {
-            ret = send_problem_ext(a, c, 422, json_pack("{s:s}", "field", key), NULL,
-                                   "unknown field '%.60s' (expected vect or catalogue, name, "
-                                   "options)",
-                                   key);
-            goto done;
-        }
-    }
-    json_t *vect = json_object_get(doc, "vect");
-    json_t *cat = json_object_get(doc, "catalogue");
-    json_t *name = json_object_get(doc, "name");
-    json_t *options = json_object_get(doc, "options");
-    if ((vect != NULL) == (cat != NULL)) {
-        ret = send_problem(a, c, 422, "give exactly one of 'vect' (the VECT text) and "
-                                      "'catalogue' (a knot name from GET /v1/catalogue)");
-        goto done;
-    }
-    if ((vect && !json_is_string(vect)) || (cat && !json_is_string(cat)) ||
-        (name && !json_is_string(name))) {
-        const char *field = vect && !json_is_string(vect)  ? "vect"
-                            : cat && !json_is_string(cat) ? "catalogue"
-                                                          : "name";
-        ret = send_problem_ext(a, c, 422, json_pack("{s:s}", "field", field), NULL,
-                               "'%s' must be a string", field);
-        goto done;
-    }
-    const char *job_name = name ? json_string_value(name) : cat ? json_string_value(cat) : "untitled";
-    if (!valid_name(job_name)) {
-        ret = send_problem_ext(a, c, 422, json_pack("{s:s}", "field", "name"), NULL,
-                               "'name' must be under %d bytes", TK_JOB_NAME_SIZE);
-        goto done;
-    }
-    tk_job_options opts = TK_JOB_OPTIONS_INIT;
-    tk_error err;
-    const char *bad = NULL;
-    if (options && tk_job_options_from_json(&opts, options, &bad, &err) != TK_OK) {
-        ret = send_input_error(a, c, &err, bad);
-        goto done;
-    }
-    if (vect) {
-        ret = submit(a, c, job_name, &opts, json_string_value(vect), json_string_length(vect));
-    } else {
-        if (!a->cfg.catalogue) {
-            ret = send_problem(a, c, 422, "this server has no catalogue (start it with --catalogue)");
-            goto done;
-        }
-        char *text = NULL;
-        size_t len = 0;
-        int rc = tk_catalogue_read(a->cfg.catalogue, json_string_value(cat), &text, &len, &err);
-        if (rc == TK_ENOTFOUND)
-            ret = send_problem_ext(a, c, 422, json_pack("{s:s}", "field", "catalogue"), NULL,
-                                   "%s", err.message);
-        else if (rc)
-            ret = send_problem(a, c, 500, "%s", err.message);
-        else
-            ret = submit(a, c, job_name, &opts, text, len);
-        free(text);
-    }
-done:
-    json_decref(doc);
-    return ret;
-}
-
 static mhd_result post_job(tk_api *a, struct MHD_Connection *c, const request *rq)
 {
     const char *type =
         MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
-    if (media_is(type, "application/json"))
-        return post_job_json(a, c, rq);
-    if (!media_is(type, "text/plain"))
-        return send_problem(a, c, 415,
-                            "send application/json ({\"vect\": ...} or {\"catalogue\": ...}) or "
-                            "text/plain (a VECT file, options in the query); got %.80s",
-                            type ? type : "no Content-Type");
-    tk_job_options opts = TK_JOB_OPTIONS_INIT;
-    query_scan q = {&opts, "untitled", {0, ""}, "", 0};
-    MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, scan_query, &q);
-    /* an unknown query parameter is an unknown option, named as in JSON */
-    if (q.rc)
-        return send_input_error(a, c, &q.err, q.bad);
-    if (!valid_name(q.name))
-        return send_problem_ext(a, c, 422, json_pack("{s:s}", "field", "name"), NULL,
-                                "'name' must be under %d bytes", TK_JOB_NAME_SIZE);
-    return submit(a, c, q.name, &opts, rq->body ? rq->body : "", rq->len);
+    query_list q = {0};
+    MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, collect_query, &q);
+    if (q.failed) {
+        free(q.pairs);
+        return send_problem(a, c, 500, "out of memory reading the query");
+    }
+    tk_submission sub;
+    tk_submission_problem p;
+    int rc = tk_submission_decode(type, q.pairs, q.n, rq->body, rq->len, a->cfg.catalogue,
+                                  &sub, &p);
+    free(q.pairs);
+    if (rc) {
+        if (p.status == 0)
+            return send_problem(a, c, 500, "%s", p.detail);
+        json_t *extra = p.member[0] ? json_pack("{s:s}", p.member, p.value) : NULL;
+        return send_problem_ext(a, c, p.status, extra, NULL, "%s", p.detail);
+    }
+    mhd_result ret = submit(a, c, sub.name, &sub.options, sub.vect, sub.len);
+    tk_submission_clear(&sub);
+    return ret;
 }
 
 /* ---- the page's files ---- */

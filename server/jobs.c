@@ -303,13 +303,14 @@ static int flush_job(job_run *jr, const tk_job *job, tk_error *err)
     return rc;
 }
 
-/* Whether the job's worker should let go of it (cancelled, or the service
- * stopping). */
-static bool letting_go(job_run *jr)
+/* Whether the job's worker should let go of it: the service is stopping,
+ * or (unless `ended`: an ended job is not cancelled any more) the job is
+ * cancelled. */
+static bool letting_go(job_run *jr, bool ended)
 {
     tk_jobs *j = jr->slot->owner;
     pthread_mutex_lock(&j->lock);
-    bool go = jr->slot->cancel || j->stopping;
+    bool go = j->stopping || (!ended && jr->slot->cancel);
     pthread_mutex_unlock(&j->lock);
     return go;
 }
@@ -335,7 +336,7 @@ static int store_job(job_run *jr, tk_job *job, bool final)
                      err.message);
             pthread_mutex_unlock(&j->lock);
         }
-        if (final ? j->stopping : letting_go(jr))
+        if (letting_go(jr, final))
             break;
         struct timespec second = {1, 0};
         nanosleep(&second, NULL);
@@ -374,7 +375,7 @@ static int on_step(const tk_step_report *s, void *user)
         store_job(jr, &copy, false);
         jr->last_flush = now_monotonic();
     }
-    return stop || letting_go(jr);
+    return stop || letting_go(jr, false);
 }
 
 /* Stores the job as failed with a message. */
@@ -657,17 +658,17 @@ void tk_jobs_stop(tk_jobs **p)
     *p = NULL;
 }
 
-int tk_jobs_submit(tk_jobs *j, const char *name, const tk_job_options *opts,
-                   const tk_curve *curve, const char *vect, tk_job *job, tk_error *err)
+int tk_job_prepare(const char *name, const tk_job_options *opts, const tk_curve *curve,
+                   size_t max_vertices, tk_job *job, tk_error *err)
 {
     tk_options run_opts;
     tk_job_options_to_run(opts, &run_opts);
     /* A run refuses what it cannot start from; finding out here gives the
      * client a 422 now instead of a failed job later.  Re-resolution is
      * bounded first, as it decides the memory the check itself takes. */
-    if (curve->nvert > j->cfg.max_vertices)
+    if (curve->nvert > max_vertices)
         return tk_error_set(err, TK_ELIMIT, "the curve has %zu vertices; the limit is %zu",
-                            curve->nvert, j->cfg.max_vertices);
+                            curve->nvert, max_vertices);
     tk_run *probe = NULL;
     if (opts->resolution > 0.0) {
         tk_options measure = run_opts;
@@ -678,17 +679,16 @@ int tk_jobs_submit(tk_jobs *j, const char *name, const tk_job_options *opts,
             return rc;
         double wanted = ceil(opts->resolution * tk_run_latest(probe)->ropelength);
         tk_run_free(&probe);
-        if (!(wanted <= (double)j->cfg.max_vertices))
+        if (!(wanted <= (double)max_vertices))
             return tk_error_set(err, TK_ELIMIT,
                                 "option 'resolution': %g vertices per unit ropelength make %.0f "
                                 "vertices; the limit is %zu",
-                                opts->resolution, wanted, j->cfg.max_vertices);
+                                opts->resolution, wanted, max_vertices);
     }
     int rc = tk_run_new(curve, &run_opts, &probe, err);
+    tk_run_free(&probe);
     if (rc)
         return rc;
-    tk_run_free(&probe);
-
     memset(job, 0, sizeof *job);
     snprintf(job->name, sizeof job->name, "%s", name);
     job->state = TK_JOB_QUEUED;
@@ -699,6 +699,15 @@ int tk_jobs_submit(tk_jobs *j, const char *name, const tk_job_options *opts,
     job->fraction = -1.0;
     job->components = curve->ncomp;
     job->latest.vertices = curve->nvert;
+    return TK_OK;
+}
+
+int tk_jobs_submit(tk_jobs *j, const char *name, const tk_job_options *opts,
+                   const tk_curve *curve, const char *vect, tk_job *job, tk_error *err)
+{
+    int rc = tk_job_prepare(name, opts, curve, j->cfg.max_vertices, job, err);
+    if (rc)
+        return rc;
     pthread_mutex_lock(&j->lock);
     if (j->stopping) {
         pthread_mutex_unlock(&j->lock);

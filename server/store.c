@@ -494,11 +494,11 @@ bool tk_store_health(tk_store *s, char *reason, size_t size)
     const char *slash = file ? strrchr(file, '/') : NULL;
     snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - file) + 1 : 1, slash ? file : ".");
     struct statvfs fs;
-    if (file && *file && statvfs(dir, &fs) == 0 && (fs.f_flag & ST_RDONLY)) {
+    bool known = file && *file && statvfs(dir, &fs) == 0;
+    if (known && (fs.f_flag & ST_RDONLY)) {
         ok = false;
         snprintf(reason, size, "the job store's file system is read-only: jobs cannot be stored");
-    } else if (file && *file && statvfs(dir, &fs) == 0 &&
-               (double)fs.f_bavail * (double)fs.f_frsize < STORE_SPACE_MIN) {
+    } else if (known && (double)fs.f_bavail * (double)fs.f_frsize < STORE_SPACE_MIN) {
         ok = false;
         snprintf(reason, size,
                  "the job store's file system is full (%.0f KiB free): jobs cannot be stored",

@@ -66,6 +66,15 @@ int tk_jobs_start(tk_store *store, const tk_jobs_config *cfg, tk_jobs **out, tk_
  * joins the workers. */
 void tk_jobs_stop(tk_jobs **p);
 
+/* The job record of a submission, once a run is seen to start from curve
+ * with the options: the vertex limit, re-resolution within it, and the
+ * run's own set-up (resampling, autoscale, thickness), without taking a
+ * step.  Fails with TK_EINVAL, TK_ELIMIT or TK_ENUMERIC and the reason.
+ * The record is queued with the default step limit when no stop
+ * criterion is set; it has no id until stored. */
+int tk_job_prepare(const char *name, const tk_job_options *opts, const tk_curve *curve,
+                   size_t max_vertices, tk_job *job, tk_error *err);
+
 /* Validates and queues a job: `curve` is the parsed `vect` text.  The
  * options are checked by setting up a run (re-resolution, autoscale,
  * thickness) without taking a step.  Fails with TK_EINVAL (bad options or

@@ -1,0 +1,163 @@
+/* Fuzz target: a job submission, from the request's media type, query and
+ * body up to the stored job.
+ *
+ * The first byte picks the Content-Type (JSON, text/plain, text/plain
+ * with a charset, something else, none).  For text/plain the bytes up to
+ * the first newline are the query ("name=value" pairs separated by '&'),
+ * the rest the body.  The submission is decoded (server/submission.c),
+ * its VECT parsed, the run's start checked as the service does, and the
+ * job stored in a real SQLite store and read back: the stored record must
+ * be the one submitted (name, options) and the stored input the submitted
+ * text byte for byte.  Refusals must carry a 4xx status and a detail;
+ * nothing may crash.  The job is deleted again so that the store stays
+ * small over millions of runs. */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "tk/jobs.h"
+#include "tk/store.h"
+#include "tk/vect.h"
+
+#include "submission.h"
+
+/* A small knot limit keeps the start's check quick for fuzzing. */
+#define FUZZ_MAX_VERTICES 2000
+#define MAX_PAIRS 32
+
+#define CHECK(cond)                                                                      \
+    do {                                                                                 \
+        if (!(cond)) {                                                                   \
+            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);    \
+            abort();                                                                     \
+        }                                                                                \
+    } while (0)
+
+/* One store for the whole fuzzing process, in a directory of its own,
+ * removed at exit. */
+static tk_store *fuzz_store;
+static char dir[] = "/tmp/tk-fuzz-submit-XXXXXX";
+
+static void remove_store(void)
+{
+    tk_store_close(&fuzz_store);
+    const char *const files[] = {"jobs.db", "jobs.db-wal", "jobs.db-shm"};
+    for (size_t i = 0; i < 3; i++) {
+        char path[sizeof dir + 16];
+        snprintf(path, sizeof path, "%s/%s", dir, files[i]);
+        unlink(path);
+    }
+    rmdir(dir);
+}
+
+static tk_store *the_store(void)
+{
+    if (!fuzz_store) {
+        CHECK(mkdtemp(dir) != NULL);
+        char path[sizeof dir + 16];
+        snprintf(path, sizeof path, "%s/jobs.db", dir);
+        tk_error err;
+        CHECK(tk_store_open(path, &fuzz_store, &err) == TK_OK);
+        atexit(remove_store);
+    }
+    return fuzz_store;
+}
+
+static void store_and_read_back(const tk_job *prepared, const tk_submission *sub)
+{
+    tk_store *store = the_store();
+    tk_job job = *prepared;
+    tk_error err;
+    CHECK(tk_store_insert(store, &job, sub->vect, &err) == TK_OK);
+    CHECK(tk_store_update(store, &job, &err) == TK_OK);
+    tk_job back;
+    CHECK(tk_store_get(store, job.id, &back, &err) == TK_OK);
+    CHECK(strcmp(back.name, sub->name) == 0);
+    CHECK(back.state == TK_JOB_QUEUED);
+    CHECK(memcmp(&back.options, &job.options, sizeof back.options) == 0 ||
+          (back.options.resolution == job.options.resolution &&
+           back.options.steps == job.options.steps && back.options.time == job.options.time &&
+           back.options.residual == job.options.residual &&
+           back.options.radius == job.options.radius && back.options.lambda == job.options.lambda &&
+           back.options.autoscale == job.options.autoscale &&
+           back.options.every == job.options.every));
+    char *text = NULL;
+    size_t len = 0;
+    CHECK(tk_store_text(store, job.id, TK_TEXT_INPUT, &text, &len, &err) == TK_OK);
+    CHECK(text && len == sub->len && memcmp(text, sub->vect, len) == 0);
+    free(text);
+    CHECK(tk_store_delete(store, job.id, &err) == TK_OK);
+    CHECK(tk_store_get(store, job.id, &back, &err) == TK_ENOTFOUND);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    if (size < 1 || size > 8192)
+        return 0;
+    static const char *const types[] = {"application/json", "text/plain",
+                                        "text/plain; charset=utf-8", "application/xml", NULL};
+    const char *type = types[data[0] % 5];
+    const char *rest = (const char *)data + 1;
+    size_t n = size - 1;
+    /* the query: the first line, split at '&' and '=' (as a server would
+     * hand it over, NUL-terminated pieces) */
+    char *query = NULL;
+    tk_query_pair pairs[MAX_PAIRS];
+    size_t npairs = 0;
+    const char *body = rest;
+    size_t len = n;
+    const char *newline = memchr(rest, '\n', n);
+    if (type && strncmp(type, "text/", 5) == 0 && newline) {
+        size_t qlen = (size_t)(newline - rest);
+        query = malloc(qlen + 1);
+        CHECK(query);
+        memcpy(query, rest, qlen);
+        query[qlen] = '\0';
+        char *save = NULL;
+        for (char *pair = strtok_r(query, "&", &save); pair && npairs < MAX_PAIRS;
+             pair = strtok_r(NULL, "&", &save)) {
+            char *eq = strchr(pair, '=');
+            if (eq)
+                *eq++ = '\0';
+            pairs[npairs++] = (tk_query_pair){pair, eq};
+        }
+        body = newline + 1;
+        len = n - qlen - 1;
+    }
+    tk_submission sub;
+    tk_submission_problem problem;
+    int rc = tk_submission_decode(type, pairs, npairs, body, len, NULL, &sub, &problem);
+    if (rc != TK_OK) {
+        CHECK(problem.status >= 400 && problem.status < 500);
+        CHECK(problem.detail[0] != '\0');
+        CHECK(sub.vect == NULL);
+        free(query);
+        return 0;
+    }
+    tk_vect_limits limits = TK_VECT_LIMITS_INIT;
+    limits.max_vertices = FUZZ_MAX_VERTICES;
+    tk_curve *curve = NULL;
+    tk_error err;
+    rc = tk_vect_parse(sub.vect, sub.len, &limits, &curve, &err);
+    if (rc == TK_OK) {
+        /* what the store keeps is a C string: the reader let no NUL in */
+        CHECK(memchr(sub.vect, '\0', sub.len) == NULL);
+        tk_job job;
+        rc = tk_job_prepare(sub.name, &sub.options, curve, FUZZ_MAX_VERTICES, &job, &err);
+        if (rc == TK_OK)
+            store_and_read_back(&job, &sub);
+        else
+            CHECK(rc == TK_EINVAL || rc == TK_ELIMIT || rc == TK_ENUMERIC);
+    } else {
+        CHECK(rc == TK_EPARSE || rc == TK_ELIMIT);
+        CHECK(strncmp(err.message, "line ", 5) == 0);
+    }
+    tk_curve_free(&curve);
+    tk_submission_clear(&sub);
+    free(query);
+    return 0;
+}
