@@ -7,7 +7,8 @@
 #   make bench      run the benchmarks (print figures, never fail on time)
 #   make fuzz       run each fuzz target FUZZ_SECONDS (default 60) with libFuzzer
 #   make deps       install missing Debian packages (quiet when all there)
-#   V=1             show full commands; SANITIZE=1 builds into build/asan
+#   V=1             show full commands; SANITIZE=1 builds into build/asan,
+#                   SANITIZE=thread into build/tsan
 #   CC=clang        any C11 compiler
 
 CC ?= cc
@@ -21,6 +22,12 @@ BUILD := build/libfuzzer
 CC := clang
 SAN_FLAGS := -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer \
 	-fno-sanitize-recover=all
+OPT := -O1
+else ifeq ($(SANITIZE),thread)
+# The service's threads (workers, request threads, the store) under
+# ThreadSanitizer: `make test` runs the service's suite against it.
+BUILD := build/tsan
+SAN_FLAGS := -fsanitize=thread -fno-omit-frame-pointer
 OPT := -O1
 else ifeq ($(SANITIZE),1)
 BUILD := build/asan
@@ -151,6 +158,7 @@ $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIB)
 test: deps
 	$(Q)$(MAKE) --no-print-directory all tests-bin
 	$(Q)$(MAKE) --no-print-directory SANITIZE=1 all tests-bin
+	$(Q)$(MAKE) --no-print-directory SANITIZE=thread build/tsan/tightknotd build/tsan/tightknot
 	$(Q)./tests/run-all.sh $(BUILD) build/asan $(CATALOGUE)
 
 tests-bin: $(TEST_BIN) $(REPLAY_BIN)

@@ -34,6 +34,7 @@ struct tk_jobs {
     int64_t *queue;       /* ring of job ids */
     size_t queue_cap, queue_head, queue_len;
     bool stopping;
+    bool joined;          /* the workers have been joined (tk_jobs_halt) */
     worker_slot *slots;
     size_t nslots;
     size_t ready;         /* workers named and scheduled (see started) */
@@ -635,20 +636,28 @@ int tk_jobs_start(tk_store *store, const tk_jobs_config *cfg, tk_jobs **out, tk_
     return TK_OK;
 }
 
-void tk_jobs_stop(tk_jobs **p)
+void tk_jobs_halt(tk_jobs *j)
 {
-    if (!p || !*p)
-        return;
-    tk_jobs *j = *p;
     pthread_mutex_lock(&j->lock);
+    bool joined = j->joined;
     j->stopping = true;
+    j->joined = true;
     for (size_t i = 0; i < j->nslots; i++)
         if (j->slots[i].run)
             tk_run_cancel(j->slots[i].run);
     pthread_cond_broadcast(&j->wake);
     pthread_mutex_unlock(&j->lock);
-    for (size_t i = 0; i < j->nslots; i++)
-        pthread_join(j->slots[i].thread, NULL);
+    if (!joined)
+        for (size_t i = 0; i < j->nslots; i++)
+            pthread_join(j->slots[i].thread, NULL);
+}
+
+void tk_jobs_stop(tk_jobs **p)
+{
+    if (!p || !*p)
+        return;
+    tk_jobs *j = *p;
+    tk_jobs_halt(j);
     pthread_cond_destroy(&j->wake);
     pthread_cond_destroy(&j->started);
     pthread_mutex_destroy(&j->lock);

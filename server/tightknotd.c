@@ -231,9 +231,13 @@ int main(int argc, char **argv)
     printf("tightknotd: %s: storing running jobs and stopping\n",
            sig == SIGINT ? "SIGINT" : "SIGTERM");
     fflush(stdout);
+    /* In order: requests get 503; the workers store their jobs and end;
+     * the HTTP threads end (a request still in flight may read the pool);
+     * only then is the pool freed. */
     tk_api_refuse(server);
-    tk_jobs_stop(&jobs);
+    tk_jobs_halt(jobs);
     tk_api_stop(&server);
+    tk_jobs_stop(&jobs);
     tk_store_close(&store);
     tk_catalogue_free(&catalogue);
     printf("tightknotd: stopped\n");

@@ -57,17 +57,30 @@ done
 # (tests/*/run.sh: the service's API, the page in a browser, the fuzz
 # corpora replayed in both builds) all end with
 # "NAME: N passed, M failed".
-# The service's suite runs a second time against the sanitizer build's
-# daemon and command line.
+# The service's suite runs a second time against the address sanitizer
+# build's daemon and command line, and a third against the thread
+# sanitizer's.
 if [ "$unit_only" -eq 0 ]; then
     suites="tests/cli-*.sh tests/*/run.sh"
     [ -n "$asan" ] && [ -x "$asan/tightknotd" ] && suites="$suites asan:tests/service/run.sh"
+    # and against the thread sanitizer's daemon, every file but the two
+    # slowest (kill -9 ten times, a file system filling up: no thread
+    # interplay the others lack)
+    tsan=build/tsan
+    [ -x "$tsan/tightknotd" ] && suites="$suites tsan:tests/service/run.sh"
     for t in $suites; do
         dir=$build
-        case "$t" in asan:*) dir=$asan; t=${t#asan:} ;; esac
+        only=""
+        case "$t" in
+        asan:*) dir=$asan; t=${t#asan:} ;;
+        tsan:*)
+            dir=$tsan; t=${t#tsan:}
+            only=$(ls tests/service/*.test.mjs | grep -v -e chaos -e store | tr '\n' ' ')
+            ;;
+        esac
         [ -f "$t" ] || continue
         TK_BUILD=$dir TK_ASAN_BUILD=$asan TK_DAEMON=$dir/tightknotd TK_CLI=$dir/tightknot \
-            TK_WEB=$dir/web sh "$t" >"$log" 2>&1
+            TK_WEB=$dir/web TK_SERVICE_TESTS=$only sh "$t" >"$log" 2>&1
         line=$(grep -E '^[a-z-]+: [0-9]+ passed, [0-9]+ failed' "$log" | tail -n 1)
         if [ -z "$line" ]; then
             failed=$((failed + 1)); echo "FAIL $t: no summary"; tail -n 20 "$log"; continue

@@ -66,6 +66,12 @@ int tk_jobs_start(tk_store *store, const tk_jobs_config *cfg, tk_jobs **out, tk_
  * joins the workers. */
 void tk_jobs_stop(tk_jobs **p);
 
+/* The first half of tk_jobs_stop: the workers stopped and joined, the
+ * jobs stored, but the pool still there, so that request threads still
+ * running can call it (submissions get TK_EBUSY); free it with
+ * tk_jobs_stop once no request thread can.  Only one thread may halt. */
+void tk_jobs_halt(tk_jobs *j);
+
 /* The job record of a submission, once a run is seen to start from curve
  * with the options: the vertex limit, re-resolution within it, and the
  * run's own set-up (resampling, autoscale, thickness), without taking a

@@ -56,11 +56,18 @@ else
 fi
 
 summary=$(mktemp)
-trap 'rm -f "$summary"' EXIT
+races=$(mktemp -d)
+trap 'rm -rf "$summary" "$races"' EXIT
+# Under ThreadSanitizer (a daemon built with SANITIZE=thread) every report
+# is written to $races and counted as a failure below.
+TSAN_OPTIONS="log_path=$races/tsan ${TSAN_OPTIONS:-}"
+export TSAN_OPTIONS
+# TK_SERVICE_TESTS: the test files to run (default: all of them)
+# shellcheck disable=SC2086
 node --test \
     --test-reporter=spec --test-reporter-destination=stdout \
     --test-reporter=./tests/service/summary-reporter.mjs --test-reporter-destination="$summary" \
-    tests/service/*.test.mjs
+    ${TK_SERVICE_TESTS:-tests/service/*.test.mjs}
 status=$?
 
 line=$(grep -E '^service: [0-9]+ passed, [0-9]+ failed, [0-9]+ skipped$' "$summary" | tail -n 1)
@@ -81,6 +88,12 @@ if [ "$status" -ne 0 ] && [ "$failed" -eq 0 ]; then
 fi
 passed=$((passed + lint_passed))
 failed=$((failed + lint_failed))
+for report in "$races"/tsan*; do
+    [ -f "$report" ] || continue
+    failed=$((failed + 1))
+    echo "FAIL ThreadSanitizer: $(grep -m 1 '^WARNING' "$report")"
+    sed -n '1,60p' "$report"
+done
 echo "service: took $(( $(date +%s) - start )) s"
 echo "service: $passed passed, $failed failed, $skipped skipped"
 [ "$failed" -eq 0 ]

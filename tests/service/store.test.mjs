@@ -7,7 +7,7 @@
 
 import assert from 'node:assert/strict';
 import { execFileSync, spawnSync } from 'node:child_process';
-import { mkdirSync, rmSync, statfsSync, writeFileSync } from 'node:fs';
+import { mkdirSync, readFileSync, rmSync, statfsSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { after, before, describe, test } from 'node:test';
 
@@ -122,6 +122,25 @@ describe('a read-only file system under the store', { skip }, () => {
         } finally {
             for (const m of mounts.splice(0)) execFileSync('umount', ['-l', m]);
         }
+    });
+});
+
+describe('a damaged store', () => {
+    test('at start: exit 2 naming the store, the file left as it was', async () => {
+        const dir = tempDir('corrupt');
+        const db = join(dir, 'jobs.db');
+        const d = await startDaemon({ workers: 1, db });
+        await waitFinal(d, (await submit(d, { catalogue: '3.1', options: { steps: 5 } })).id);
+        await d.stop();
+        // the header page overwritten: no longer an SQLite file
+        const bytes = readFileSync(db);
+        const damaged = Buffer.from(bytes);
+        damaged.fill(0x5a, 0, Math.min(4096, damaged.length));
+        writeFileSync(db, damaged);
+        const r = spawnSync(DAEMON, ['--port', '0', '--db', db], { encoding: 'utf8', timeout: 10000 });
+        assert.equal(r.status, 2, r.stdout + r.stderr);
+        assert.match(r.stderr, /job store .*jobs\.db.*(not a database|malformed)/);
+        assert.ok(readFileSync(db).equals(damaged), 'the damaged file is kept for whoever repairs it');
     });
 });
 
