@@ -432,6 +432,18 @@ static bool accepts_json(struct MHD_Connection *c)
     return accept && strstr(accept, "application/json") && !strstr(accept, "text/plain");
 }
 
+/* A stored text that does not read back as written: a 500 naming it, and
+ * the store reported damaged (health says so). */
+static mhd_result damaged(tk_api *a, struct MHD_Connection *c, const tk_job *job,
+                          const char *what, const char *why)
+{
+    char message[TK_ERROR_MESSAGE_SIZE];
+    snprintf(message, sizeof message, "the stored %s of job %lld does not read back: %.200s",
+             what, (long long)job->id, why);
+    tk_store_report_damage(a->store, message);
+    return send_problem(a, c, 500, "%s", message);
+}
+
 static mhd_result get_job_vect(tk_api *a, struct MHD_Connection *c, const tk_job *job)
 {
     char *text = NULL;
@@ -442,6 +454,14 @@ static mhd_result get_job_vect(tk_api *a, struct MHD_Connection *c, const tk_job
         rc = tk_store_text(a->store, job->id, TK_TEXT_INPUT, &text, &len, &err);
     if (rc)
         return send_problem(a, c, 500, "%s", err.message);
+    /* Every stored curve parsed when it was written: one that does not now
+     * was damaged in the store, and is not served as if it were a knot. */
+    tk_curve *check = NULL;
+    if (text && tk_vect_parse(text, len, NULL, &check, &err) != TK_OK) {
+        free(text);
+        return damaged(a, c, job, "curve", err.message);
+    }
+    tk_curve_free(&check);
     if (accepts_json(c)) {
         json_t *o = json_pack("{s:I, s:I, s:s%}", "id", (json_int_t)job->id, "step",
                               (json_int_t)job->latest.step, "vect", text ? text : "", len);
@@ -462,8 +482,12 @@ static mhd_result get_job_text_json(tk_api *a, struct MHD_Connection *c, const t
     tk_error err;
     if (tk_store_text(a->store, job->id, which, &text, &len, &err) != TK_OK)
         return send_problem(a, c, 500, "%s", err.message);
-    json_t *doc = text ? json_loadb(text, len, 0, NULL) : NULL;
+    json_error_t jerr;
+    json_t *doc = text ? json_loadb(text, len, 0, &jerr) : NULL;
+    bool broken = text && !doc;
     free(text);
+    if (broken)
+        return damaged(a, c, job, which == TK_TEXT_CONTACTS ? "contacts" : "history", jerr.text);
     if (which == TK_TEXT_CONTACTS) {
         if (!doc) /* not measured yet */
             doc = json_pack("{s:I, s:n, s:[], s:[], s:[]}", "step", (json_int_t)0, "thickness",

@@ -24,6 +24,8 @@ struct tk_store {
     /* Why the last write failed (a full disk, a read-only file), "" once
      * a write succeeds again: what health reports. */
     char write_error[TK_ERROR_MESSAGE_SIZE];
+    /* Damage a reader found in the stored texts: kept until restart. */
+    char damage[TK_ERROR_MESSAGE_SIZE];
 };
 
 /* Notes the outcome of a write for tk_store_health; returns status.  Lock
@@ -483,12 +485,25 @@ int tk_store_delete(tk_store *s, int64_t id, tk_error *err)
     return status;
 }
 
+void tk_store_report_damage(tk_store *s, const char *what)
+{
+    pthread_mutex_lock(&s->lock);
+    if (!s->damage[0])
+        snprintf(s->damage, sizeof s->damage, "%s", what);
+    pthread_mutex_unlock(&s->lock);
+}
+
 bool tk_store_health(tk_store *s, char *reason, size_t size)
 {
     pthread_mutex_lock(&s->lock);
     bool ok = true;
     /* The file system first: a full or read-only one fails the next
      * write, and health should say so before a job finds out. */
+    if (s->damage[0]) {
+        snprintf(reason, size, "the job store is damaged: %s", s->damage);
+        pthread_mutex_unlock(&s->lock);
+        return false;
+    }
     const char *file = sqlite3_db_filename(s->db, "main");
     char dir[4096];
     const char *slash = file ? strrchr(file, '/') : NULL;

@@ -110,10 +110,16 @@ int tk_store_unfinished(tk_store *s, int64_t **ids, size_t *n, tk_error *err);
  * none.  The caller sees that it is not running. */
 int tk_store_delete(tk_store *s, int64_t id, tk_error *err);
 
-/* Whether the store can take jobs: writable, its last write succeeded,
- * and its newest job reads back.  When not, reason says why (for
- * GET /v1/health). */
+/* Whether the store can take jobs: not found damaged, writable, its last
+ * write succeeded, and its newest job reads back.  When not, reason says
+ * why (for GET /v1/health). */
 bool tk_store_health(tk_store *s, char *reason, size_t size);
+
+/* Records that a stored text did not read back as what was written (a
+ * VECT that does not parse, JSON that is not JSON): SQLite cannot see
+ * bytes overwritten inside a row, its readers can.  Health reports the
+ * first such damage until the daemon restarts. */
+void tk_store_report_damage(tk_store *s, const char *what);
 
 /* Number of jobs in each state. */
 int tk_store_count_states(tk_store *s, size_t counts[TK_JOB_STATES], tk_error *err);

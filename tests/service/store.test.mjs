@@ -144,6 +144,38 @@ describe('a damaged store', () => {
     });
 });
 
+describe('texts damaged in the store while the daemon runs', () => {
+    // SQLite checks its pages, not the bytes inside a row: random bytes
+    // written over a stored curve read back as they are.  The daemon reads
+    // each stored text back as what it wrote (a VECT, JSON) before serving
+    // it, and says so when it does not.
+    test('a curve of random bytes and broken contacts: 500 naming them, health 503 degraded', async () => {
+        const d = await startDaemon({ workers: 1 });
+        try {
+            const job = await waitFinal(d, (await submit(d, { catalogue: '3.1', options: { steps: 5 } })).id);
+            const other = await waitFinal(d, (await submit(d, { catalogue: '4.1', options: { steps: 5 } })).id);
+            assert.equal((await d.get(`/v1/jobs/${job.id}/vect`)).status, 200);
+            assert.equal((await d.get('/v1/health')).status, 200);
+            execFileSync('sqlite3', [d.db, `UPDATE jobs SET curve = CAST(randomblob(3000) AS TEXT) WHERE id = ${job.id};` +
+                `UPDATE jobs SET contacts = '{"struts": [' || 'x' WHERE id = ${job.id};`]);
+            const v = await d.get(`/v1/jobs/${job.id}/vect`);
+            assert.equal(v.status, 500, v.text.slice(0, 200));
+            assert.match(v.json.detail, new RegExp(`the stored curve of job ${job.id} does not read back`));
+            const st = await d.get(`/v1/jobs/${job.id}/struts`);
+            assert.equal(st.status, 500);
+            assert.match(st.json.detail, /stored contacts/);
+            const h = await d.get('/v1/health');
+            assert.equal(h.status, 503);
+            assert.equal(h.json.health, 'degraded');
+            assert.match(h.json.detail, /damaged: the stored curve/);
+            // the undamaged job still reads
+            assert.equal((await d.get(`/v1/jobs/${other.id}/vect`)).status, 200);
+        } finally {
+            await d.stop();
+        }
+    });
+});
+
 describe('bounds on what a job keeps', () => {
     let d;
     before(async () => {
