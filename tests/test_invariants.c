@@ -191,6 +191,125 @@ START_TEST(catalogue_links)
 }
 END_TEST
 
+static long long det_of(const tk_curve *c, size_t comp, unsigned long long seed)
+{
+    long long det = -1;
+    size_t m = 0;
+    tk_error err;
+    ck_assert_msg(tk_knot_determinant(c, comp, seed, &det, &m, &err) == TK_OK, "%s", err.message);
+    return det;
+}
+
+START_TEST(torus_knot_determinants)
+{
+    /* |Delta(-1)| of T(2, q) is q; of T(3, 4) (8_19) 3; of T(3, 5)
+     * (10_124) 1; a round polygon is the unknot */
+    const struct {
+        int p, q;
+        long long det;
+    } known[] = {{2, 3, 3}, {2, 5, 5}, {2, 7, 7}, {2, 9, 9}, {3, 4, 3}, {3, 5, 1}};
+    for (size_t k = 0; k < sizeof known / sizeof *known; k++) {
+        tk_curve *c = NULL;
+        ck_assert_int_eq(tk_generate_torus(known[k].p, known[k].q, 120, &c, NULL), TK_OK);
+        for (unsigned long long seed = 1; seed <= 12; seed++)
+            ck_assert_msg(det_of(c, 0, seed) == known[k].det, "T(%d,%d) seed %llu: %lld",
+                          known[k].p, known[k].q, seed, det_of(c, 0, seed));
+        tk_curve_free(&c);
+    }
+    tk_curve *round = tkt_regular_polygon(50, 3.0);
+    ck_assert_int_eq(det_of(round, 0, 7), 1);
+    tk_curve_free(&round);
+}
+END_TEST
+
+START_TEST(catalogue_knot_determinants)
+{
+    if (!tkt_catalogue_dir()) {
+        printf("catalogue absent: catalogue determinants skipped\n");
+        return;
+    }
+    /* Rolfsen's table */
+    const struct {
+        const char *name;
+        long long det;
+    } known[] = {{"3.1.vect", 3},  {"4.1.vect", 5},  {"5.1.vect", 5},  {"5.2.vect", 7},
+                 {"6.1.vect", 9},  {"6.2.vect", 11}, {"6.3.vect", 13}, {"7.1.vect", 7},
+                 {"7.7.vect", 21}, {"8.18.vect", 45}, {"8.19.vect", 3}, {"10.124.vect", 1}};
+    for (size_t k = 0; k < sizeof known / sizeof *known; k++) {
+        tk_curve *c = tkt_catalogue_curve(known[k].name);
+        for (unsigned long long seed = 1; seed <= 4; seed++)
+            ck_assert_msg(det_of(c, 0, seed) == known[k].det, "%s seed %llu: %lld", known[k].name,
+                          seed, det_of(c, 0, seed));
+        tk_curve_free(&c);
+    }
+    /* every knot of the catalogue: the same from two projections, and odd
+     * (the determinant of a knot always is) */
+    size_t count = 0, knots = 0;
+    char **names = tkt_catalogue_names(&count);
+    for (size_t i = 0; i < count; i++) {
+        tk_curve *c = tkt_catalogue_curve(names[i]);
+        if (c->ncomp == 1 && c->closed[0]) {
+            long long a = det_of(c, 0, 1), b = det_of(c, 0, 2);
+            ck_assert_msg(a == b && a % 2 == 1, "%s: %lld and %lld", names[i], a, b);
+            knots++;
+        }
+        tk_curve_free(&c);
+    }
+    tkt_free_names(names, count);
+    ck_assert_uint_ge(knots, 250);
+}
+END_TEST
+
+START_TEST(a_crossing_change_is_caught)
+{
+    /* The trefoil (sin t + 2 sin 2t, cos t - 2 cos 2t, -sin 3t) seen from
+     * above has three crossings; lowering the over strand of one of them
+     * below the other gives the unknot. */
+    size_t n = 300;
+    bool closed = true;
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_curve_new(&c, 1, &n, &closed, NULL), TK_OK);
+    for (size_t i = 0; i < n; i++) {
+        double t = 2.0 * M_PI * (double)i / (double)n;
+        double *x = tk_curve_vertex(c, i);
+        x[0] = sin(t) + 2.0 * sin(2.0 * t);
+        x[1] = cos(t) - 2.0 * cos(2.0 * t);
+        x[2] = -sin(3.0 * t);
+    }
+    ck_assert_int_eq(det_of(c, 0, 3), 3);
+    /* the first crossing of the picture in the xy plane, by brute force */
+    size_t over = n, under = n;
+    for (size_t i = 0; i < n && over == n; i++)
+        for (size_t j = i + 2; j < n && over == n; j++) {
+            if (i == 0 && j == n - 1)
+                continue;
+            const double *a = tk_curve_vertex(c, i), *b = tk_curve_vertex(c, (i + 1) % n);
+            const double *q = tk_curve_vertex(c, j), *d = tk_curve_vertex(c, (j + 1) % n);
+            double rx = b[0] - a[0], ry = b[1] - a[1], sx = d[0] - q[0], sy = d[1] - q[1];
+            double den = rx * sy - ry * sx;
+            if (den == 0.0)
+                continue;
+            double s = ((q[0] - a[0]) * sy - (q[1] - a[1]) * sx) / den;
+            double t = ((q[0] - a[0]) * ry - (q[1] - a[1]) * rx) / den;
+            if (s > 0 && s < 1 && t > 0 && t < 1) {
+                bool i_over = a[2] + s * (b[2] - a[2]) > q[2] + t * (d[2] - q[2]);
+                over = i_over ? i : j;
+                under = i_over ? j : i;
+            }
+        }
+    ck_assert_uint_lt(over, n);
+    /* push the over strand, a few edges either side, under the other */
+    double floor = tk_curve_vertex(c, under)[2] - 1.0;
+    for (long d = -4; d <= 5; d++) {
+        double *x = tk_curve_vertex(c, (size_t)(((long)over + d + (long)n) % (long)n));
+        x[2] = fmin(x[2], floor);
+    }
+    for (unsigned long long seed = 1; seed <= 6; seed++)
+        ck_assert_int_eq(det_of(c, 0, seed), 1);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("invariants");
@@ -202,5 +321,11 @@ int main(void)
     tcase_add_test(tc, a_strand_passage_is_caught);
     tcase_add_test(tc, catalogue_links);
     suite_add_tcase(s, tc);
+    TCase *knots = tcase_create("determinant");
+    tcase_set_timeout(knots, 60);
+    tcase_add_test(knots, torus_knot_determinants);
+    tcase_add_test(knots, catalogue_knot_determinants);
+    tcase_add_test(knots, a_crossing_change_is_caught);
+    suite_add_tcase(s, knots);
     return tkt_run_suite(s);
 }
