@@ -213,7 +213,9 @@ void tk_curve_centroid(const tk_curve *c, double centre[3])
         centre[k] = c->nvert ? s[k] / (double)c->nvert : 0.0;
 }
 
-int tk_curve_validate(const tk_curve *c, tk_error *err)
+/* tk_curve_validate, and with `range` also the engine's magnitudes, in
+ * one pass: measuring runs this on every step of a flow. */
+static int check_curve(const tk_curve *c, bool range, tk_error *err)
 {
     if (c->ncomp == 0)
         return tk_error_set(err, TK_EINVAL, "the curve has no components");
@@ -229,42 +231,27 @@ int tk_curve_validate(const tk_curve *c, tk_error *err)
                                 i, n);
         for (size_t k = 0; k < n; k++) {
             const double *x = c->xyz + 3 * (c->offset[i] + k);
-            if (!isfinite(x[0]) || !isfinite(x[1]) || !isfinite(x[2]))
-                return tk_error_set(err, TK_EINVAL,
-                                    "component %zu vertex %zu has a non-finite coordinate",
-                                    i, k);
-        }
-        size_t ne = tk_curve_comp_edges(c, i);
-        for (size_t k = 0; k < ne; k++)
-            if (!(tk_curve_edge_length(c, i, k) > 0.0))
-                return tk_error_set(err, TK_EINVAL,
-                                    "component %zu: vertices %zu and %zu coincide (zero-length edge)",
-                                    i, k, (k + 1) % n);
-    }
-    return TK_OK;
-}
-
-int tk_curve_check_range(const tk_curve *c, tk_error *err)
-{
-    int rc = tk_curve_validate(c, err);
-    if (rc)
-        return rc;
-    for (size_t i = 0; i < c->ncomp; i++) {
-        size_t n = tk_curve_comp_vertices(c, i);
-        for (size_t k = 0; k < n; k++) {
-            const double *x = c->xyz + 3 * (c->offset[i] + k);
-            for (int a = 0; a < 3; a++)
-                if (!(fabs(x[a]) <= TK_CURVE_COORD_MAX))
+            for (int a = 0; a < 3; a++) {
+                if (!isfinite(x[a]))
+                    return tk_error_set(err, TK_EINVAL,
+                                        "component %zu vertex %zu has a non-finite coordinate",
+                                        i, k);
+                if (range && !(fabs(x[a]) <= TK_CURVE_COORD_MAX))
                     return tk_error_set(err, TK_EINVAL,
                                         "component %zu vertex %zu has coordinate %c = %g, "
                                         "beyond the +-%g the engine measures in: scale the "
                                         "curve down",
                                         i, k, "xyz"[a], x[a], TK_CURVE_COORD_MAX);
+            }
         }
         size_t ne = tk_curve_comp_edges(c, i);
         for (size_t k = 0; k < ne; k++) {
             double l = tk_curve_edge_length(c, i, k);
-            if (!(l >= TK_CURVE_EDGE_MIN))
+            if (!(l > 0.0))
+                return tk_error_set(err, TK_EINVAL,
+                                    "component %zu: vertices %zu and %zu coincide (zero-length edge)",
+                                    i, k, (k + 1) % n);
+            if (range && !(l >= TK_CURVE_EDGE_MIN))
                 return tk_error_set(err, TK_EINVAL,
                                     "component %zu: the edge from vertex %zu to %zu is %g "
                                     "long, shorter than the %g the engine measures: scale "
@@ -273,6 +260,16 @@ int tk_curve_check_range(const tk_curve *c, tk_error *err)
         }
     }
     return TK_OK;
+}
+
+int tk_curve_validate(const tk_curve *c, tk_error *err)
+{
+    return check_curve(c, false, err);
+}
+
+int tk_curve_check_range(const tk_curve *c, tk_error *err)
+{
+    return check_curve(c, true, err);
 }
 
 /* Solves the tridiagonal system with sub-diagonal a, diagonal b,

@@ -3,25 +3,6 @@
 #include <math.h>
 #include <string.h>
 
-static inline double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline void sub3(const double *a, const double *b, double *out)
-{
-    out[0] = a[0] - b[0];
-    out[1] = a[1] - b[1];
-    out[2] = a[2] - b[2];
-}
-
-static inline void cross3(const double *a, const double *b, double *out)
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 static inline double clamp01(double x)
 {
     return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);
@@ -37,8 +18,8 @@ static inline void point_at(const double *a0, const double *d, double s, double 
 static inline double dist3(const double *a, const double *b)
 {
     double d[3];
-    sub3(a, b, d);
-    return sqrt(dot3(d, d));
+    tk_sub3(a, b, d);
+    return sqrt(tk_dot3(d, d));
 }
 
 /* Parameter of the point of segment (a0, d) closest to x. */
@@ -47,8 +28,8 @@ static double project(const double *x, const double *a0, const double *d, double
     if (dd <= 0.0)
         return 0.0;
     double r[3];
-    sub3(x, a0, r);
-    return clamp01(dot3(r, d) / dd);
+    tk_sub3(x, a0, r);
+    return clamp01(tk_dot3(r, d) / dd);
 }
 
 static bool snap(double *s)
@@ -75,11 +56,11 @@ void tk_segment_closest(const double a0[3], const double a1[3],
                         tk_closest *out)
 {
     double d1[3], d2[3], r[3];
-    sub3(a1, a0, d1);
-    sub3(b1, b0, d2);
-    sub3(a0, b0, r);
-    double a = dot3(d1, d1), e = dot3(d2, d2), b = dot3(d1, d2);
-    double c = dot3(d1, r), f = dot3(d2, r);
+    tk_sub3(a1, a0, d1);
+    tk_sub3(b1, b0, d2);
+    tk_sub3(a0, b0, r);
+    double a = tk_dot3(d1, d1), e = tk_dot3(d2, d2), b = tk_dot3(d1, d2);
+    double c = tk_dot3(d1, r), f = tk_dot3(d2, r);
 
     double best_s = 0.0, best_t = project(a0, b0, d2, e);
     double p[3], q[3];
@@ -174,8 +155,8 @@ void tk_segment_closest(const double a0[3], const double a1[3],
 void tk_segment_distance_gradient(const tk_closest *c, double grad[12])
 {
     double u[3];
-    sub3(c->p, c->q, u);
-    double n = sqrt(dot3(u, u));
+    tk_sub3(c->p, c->q, u);
+    double n = sqrt(tk_dot3(u, u));
     if (!(n > 0.0)) {
         memset(grad, 0, 12 * sizeof *grad);
         return;
@@ -193,10 +174,10 @@ double tk_vertex_turning(const double prev[3], const double v[3],
                          const double next[3])
 {
     double a[3], b[3], x[3];
-    sub3(v, prev, a);
-    sub3(next, v, b);
-    cross3(a, b, x);
-    return atan2(sqrt(dot3(x, x)), dot3(a, b));
+    tk_sub3(v, prev, a);
+    tk_sub3(next, v, b);
+    tk_cross3(a, b, x);
+    return atan2(sqrt(tk_dot3(x, x)), tk_dot3(a, b));
 }
 
 /* Equation (3) written without angles: with a, b the incoming and outgoing
@@ -207,11 +188,11 @@ double tk_vertex_minrad(const double prev[3], const double v[3],
                         const double next[3])
 {
     double a[3], b[3], x[3];
-    sub3(v, prev, a);
-    sub3(next, v, b);
-    cross3(a, b, x);
-    double la = sqrt(dot3(a, a)), lb = sqrt(dot3(b, b)), ab = dot3(a, b);
-    double sin_term = sqrt(dot3(x, x));
+    tk_sub3(v, prev, a);
+    tk_sub3(next, v, b);
+    tk_cross3(a, b, x);
+    double la = sqrt(tk_dot3(a, a)), lb = sqrt(tk_dot3(b, b)), ab = tk_dot3(a, b);
+    double sin_term = sqrt(tk_dot3(x, x));
     if (!(sin_term > 0.0))
         return ab >= 0.0 ? INFINITY : 0.0;
     /* For turns past a right angle |a||b| + a.b cancels; the identity
@@ -230,12 +211,12 @@ double tk_vertex_radius_gradient(const double prev[3], const double v[3],
                                  const double next[3], int edge, double grad[9])
 {
     double a[3], b[3], x[3];
-    sub3(v, prev, a);
-    sub3(next, v, b);
-    cross3(a, b, x);
-    double la = sqrt(dot3(a, a)), lb = sqrt(dot3(b, b));
-    double ab = dot3(a, b);
-    double den = sqrt(dot3(x, x));
+    tk_sub3(v, prev, a);
+    tk_sub3(next, v, b);
+    tk_cross3(a, b, x);
+    double la = sqrt(tk_dot3(a, a)), lb = sqrt(tk_dot3(b, b));
+    double ab = tk_dot3(a, b);
+    double den = sqrt(tk_dot3(x, x));
     memset(grad, 0, 9 * sizeof *grad);
     if (!(den > 0.0))
         return ab >= 0.0 ? INFINITY : 0.0;
@@ -343,8 +324,8 @@ void tk_curve_length_gradient(const tk_curve *c, double *grad)
             size_t h = tk_curve_vertex_index(c, comp, k);
             size_t t = tk_curve_vertex_index(c, comp, k + 1);
             double u[3];
-            sub3(c->xyz + 3 * t, c->xyz + 3 * h, u);
-            double n = sqrt(dot3(u, u));
+            tk_sub3(c->xyz + 3 * t, c->xyz + 3 * h, u);
+            double n = sqrt(tk_dot3(u, u));
             if (!(n > 0.0))
                 continue;
             for (int j = 0; j < 3; j++) {

@@ -4,34 +4,18 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "tk/geometry.h"
+
 /* The linking integral of two polygons is exact within rounding: a sum
  * further than this from an integer means the polygons (nearly) touch. */
 #define LINKING_INTEGER_TOLERANCE 1e-6
-
-static void sub3(const double *a, const double *b, double *out)
-{
-    for (int k = 0; k < 3; k++)
-        out[k] = a[k] - b[k];
-}
-
-static void cross3(const double *a, const double *b, double *out)
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
 
 /* The unit normal of the plane through the origin spanned by u and v, or
  * zero when they are parallel. */
 static void unit_normal(const double *u, const double *v, double *n)
 {
-    cross3(u, v, n);
-    double len = sqrt(dot3(n, n));
+    tk_cross3(u, v, n);
+    double len = sqrt(tk_dot3(n, n));
     for (int k = 0; k < 3; k++)
         n[k] = len > 0.0 ? n[k] / len : 0.0;
 }
@@ -51,22 +35,22 @@ static double segment_pair(const double *p1, const double *p2, const double *p3,
                            const double *p4)
 {
     double r13[3], r14[3], r23[3], r24[3], r12[3], r34[3];
-    sub3(p3, p1, r13);
-    sub3(p4, p1, r14);
-    sub3(p3, p2, r23);
-    sub3(p4, p2, r24);
-    sub3(p2, p1, r12);
-    sub3(p4, p3, r34);
+    tk_sub3(p3, p1, r13);
+    tk_sub3(p4, p1, r14);
+    tk_sub3(p3, p2, r23);
+    tk_sub3(p4, p2, r24);
+    tk_sub3(p2, p1, r12);
+    tk_sub3(p4, p3, r34);
     double n1[3], n2[3], n3[3], n4[3];
     unit_normal(r13, r14, n1);
     unit_normal(r14, r24, n2);
     unit_normal(r24, r23, n3);
     unit_normal(r23, r13, n4);
-    double omega = clamped_asin(dot3(n1, n2)) + clamped_asin(dot3(n2, n3)) +
-                   clamped_asin(dot3(n3, n4)) + clamped_asin(dot3(n4, n1));
+    double omega = clamped_asin(tk_dot3(n1, n2)) + clamped_asin(tk_dot3(n2, n3)) +
+                   clamped_asin(tk_dot3(n3, n4)) + clamped_asin(tk_dot3(n4, n1));
     double orient[3];
-    cross3(r34, r12, orient);
-    double s = dot3(orient, r13);
+    tk_cross3(r34, r12, orient);
+    double s = tk_dot3(orient, r13);
     return s > 0.0 ? omega : (s < 0.0 ? -omega : 0.0);
 }
 
@@ -145,7 +129,7 @@ static void frame(unsigned long long *s, double e1[3], double e2[3], double e3[3
     e3[2] = z;
     double a[3] = {fabs(e3[0]) < 0.9 ? 1.0 : 0.0, fabs(e3[0]) < 0.9 ? 0.0 : 1.0, 0.0};
     unit_normal(e3, a, e1);
-    cross3(e3, e1, e2);
+    tk_cross3(e3, e1, e2);
 }
 
 /* The crossings of the knot seen along e3: for each pair of non-adjacent
@@ -163,9 +147,9 @@ static int find_crossings(const tk_curve *c, size_t comp, const double e1[3], co
         return tk_error_set(err, TK_ENOMEM, "out of memory for a projection");
     for (size_t i = 0; i < n; i++) {
         const double *x = tk_curve_vertex(c, tk_curve_vertex_index(c, comp, i));
-        p[3 * i] = dot3(x, e1);
-        p[3 * i + 1] = dot3(x, e2);
-        p[3 * i + 2] = dot3(x, e3);
+        p[3 * i] = tk_dot3(x, e1);
+        p[3 * i + 1] = tk_dot3(x, e2);
+        p[3 * i + 2] = tk_dot3(x, e3);
     }
     int rc = TK_OK;
     for (size_t i = 0; i < n && !rc; i++) {

@@ -375,8 +375,10 @@ static int on_step(const tk_step_report *s, void *user)
     if (now - jr->last_flush >= j->cfg.flush_seconds) {
         store_job(jr, &copy, false);
         jr->last_flush = now_monotonic();
+        /* a paused store may have waited through a cancel or a stop */
+        stop = stop || letting_go(jr, false);
     }
-    return stop || letting_go(jr, false);
+    return stop;
 }
 
 /* Stores the job as failed with a message. */

@@ -12,6 +12,27 @@
 
 #include "tk/curve.h"
 
+/* Vectors of R^3 as three doubles: the products the geometry and the
+ * invariants are written in. */
+static inline double tk_dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static inline void tk_sub3(const double *a, const double *b, double *out)
+{
+    out[0] = a[0] - b[0];
+    out[1] = a[1] - b[1];
+    out[2] = a[2] - b[2];
+}
+
+static inline void tk_cross3(const double *a, const double *b, double *out)
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 /* Closest points of two segments p(s) = a0 + s (a1 - a0) and
  * q(t) = b0 + t (b1 - b0), s, t in [0, 1]. */
 typedef struct tk_closest {

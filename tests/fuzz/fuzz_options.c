@@ -14,17 +14,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fuzz.h"
 #include "tk/generate.h"
 #include "tk/jobspec.h"
 #include "tk/tighten.h"
-
-#define CHECK(cond)                                                                      \
-    do {                                                                                 \
-        if (!(cond)) {                                                                   \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);    \
-            abort();                                                                     \
-        }                                                                                \
-    } while (0)
 
 static int from_text(tk_job_options *o, const char *text, size_t len)
 {
@@ -84,9 +77,7 @@ static void check_round_trip(const tk_job_options *o)
     back.autoscale = !o->autoscale; /* so that the flag must be read back */
     tk_error err;
     CHECK(tk_job_options_from_json(&back, j, NULL, &err) == TK_OK);
-    CHECK(back.resolution == o->resolution && back.steps == o->steps && back.time == o->time &&
-          back.residual == o->residual && back.radius == o->radius &&
-          back.lambda == o->lambda && back.autoscale == o->autoscale && back.every == o->every);
+    CHECK(fuzz_options_equal(&back, o));
     json_decref(j);
 }
 

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "fuzz.h"
 #include "tk/jobs.h"
 #include "tk/store.h"
 #include "tk/vect.h"
@@ -26,14 +27,6 @@
 /* A small knot limit keeps the start's check quick for fuzzing. */
 #define FUZZ_MAX_VERTICES 2000
 #define MAX_PAIRS 32
-
-#define CHECK(cond)                                                                      \
-    do {                                                                                 \
-        if (!(cond)) {                                                                   \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);    \
-            abort();                                                                     \
-        }                                                                                \
-    } while (0)
 
 /* One store for the whole fuzzing process, in a directory of its own,
  * removed at exit. */
@@ -76,13 +69,7 @@ static void store_and_read_back(const tk_job *prepared, const tk_submission *sub
     CHECK(tk_store_get(store, job.id, &back, &err) == TK_OK);
     CHECK(strcmp(back.name, sub->name) == 0);
     CHECK(back.state == TK_JOB_QUEUED);
-    CHECK(memcmp(&back.options, &job.options, sizeof back.options) == 0 ||
-          (back.options.resolution == job.options.resolution &&
-           back.options.steps == job.options.steps && back.options.time == job.options.time &&
-           back.options.residual == job.options.residual &&
-           back.options.radius == job.options.radius && back.options.lambda == job.options.lambda &&
-           back.options.autoscale == job.options.autoscale &&
-           back.options.every == job.options.every));
+    CHECK(fuzz_options_equal(&back.options, &job.options));
     char *text = NULL;
     size_t len = 0;
     CHECK(tk_store_text(store, job.id, TK_TEXT_INPUT, &text, &len, &err) == TK_OK);

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fuzz.h"
 #include "tk/struts.h"
 #include "tk/thickness.h"
 #include "tk/vect.h"
@@ -22,14 +23,6 @@
  * with the O(V^2) brute-force check. */
 #define FUZZ_MAX_VERTICES 256
 #define BRUTE_MAX_VERTICES 64
-
-#define CHECK(cond)                                                                      \
-    do {                                                                                 \
-        if (!(cond)) {                                                                   \
-            fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);    \
-            abort();                                                                     \
-        }                                                                                \
-    } while (0)
 
 static void check_round_trip(const tk_curve *c)
 {

@@ -75,7 +75,7 @@ describe('chaos: kill -9 ten times under load', () => {
 
         const random = rng(2026);
         const storedBefore = new Map();
-        let resumedMidRun = new Set();
+        const resumedMidRun = new Set();
         try {
             for (let k = 0; k < KILLS; k++) {
                 await sleep(300 + random() * 3000);
