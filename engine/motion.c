@@ -1,0 +1,172 @@
+/* The motion: minus the length gradient (equation 14), the tangential
+ * motion that evens out the edges (section 4.2), and their resolution
+ * against the active constraints (equation 13, Proposition 3).  See run.h
+ * for the rooms of the flow. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "run.h"
+#include "tk/geometry.h"
+
+void tk_motion_free(tk_run *r)
+{
+    free(r->motion.grad);
+    free(r->motion.motion);
+    free(r->motion.work);
+    free(r->motion.x);
+}
+
+int tk_motion_fit(tk_run *r, size_t vertices, tk_error *err)
+{
+    free(r->motion.grad);
+    free(r->motion.motion);
+    free(r->motion.work);
+    r->motion.grad = calloc(3 * vertices, sizeof *r->motion.grad);
+    r->motion.motion = calloc(3 * vertices, sizeof *r->motion.motion);
+    r->motion.work = calloc(3 * vertices, sizeof *r->motion.work);
+    if (!r->motion.grad || !r->motion.motion || !r->motion.work)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for a run of %zu vertices", vertices);
+    return TK_OK;
+}
+
+static int grow_forces(tk_run *r, size_t n, tk_error *err)
+{
+    if (n <= r->motion.x_capacity)
+        return TK_OK;
+    size_t cap = r->motion.x_capacity ? r->motion.x_capacity : 64;
+    while (cap < n)
+        cap *= 2;
+    double *x = realloc(r->motion.x, cap * sizeof *x);
+    if (!x)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for %zu constraints", n);
+    r->motion.x = x;
+    r->motion.x_capacity = cap;
+    return TK_OK;
+}
+
+/* out = A x (3V entries). */
+static void multiply(const cholmod_sparse *a, const double *x, double *out, size_t rows)
+{
+    memset(out, 0, rows * sizeof *out);
+    const int *colp = a->p, *row = a->i;
+    const double *val = a->x;
+    for (size_t j = 0; j < a->ncol; j++)
+        for (int k = colp[j]; k < colp[j + 1]; k++)
+            out[row[k]] += val[k] * x[j];
+}
+
+/* Section 4.2: a velocity along each vertex's tangent proportional to how
+ * far the vertex is from its share of the component's length, so that the
+ * edges even out.  Scaled to the mean size of the length gradient so the
+ * two motions keep their proportion as the curve tightens. */
+static void add_equalising_motion(tk_run *r, const tk_curve *c, double *u)
+{
+    size_t nv = c->nvert;
+    const double *grad = r->motion.grad;
+    double mean_grad = 0.0;
+    for (size_t v = 0; v < nv; v++)
+        mean_grad += tk_norm(grad + 3 * v, 3);
+    mean_grad /= (double)(nv ? nv : 1);
+    if (!(r->opt.equalise > 0.0) || !(mean_grad > 0.0))
+        return;
+    for (size_t comp = 0; comp < c->ncomp; comp++) {
+        size_t n = tk_curve_comp_vertices(c, comp), ne = tk_curve_comp_edges(c, comp);
+        double total = tk_curve_comp_length(c, comp), mean_edge = total / (double)ne;
+        double *offset = r->motion.work; /* n entries suffice: 3V >= n */
+        double arc = 0.0, shift = 0.0;
+        for (size_t k = 0; k < n; k++) {
+            offset[k] = total * (double)k / (double)ne - arc;
+            shift += offset[k];
+            if (k < ne)
+                arc += tk_curve_edge_length(c, comp, k);
+        }
+        /* A closed component's vertices may all slide together: only their
+         * spacing matters. */
+        shift = c->closed[comp] ? shift / (double)n : 0.0;
+        for (size_t k = 0; k < n; k++) {
+            size_t v = c->offset[comp] + k;
+            if (r->shared.fixed[v] || (!c->closed[comp] && (k == 0 || k + 1 == n)))
+                continue;
+            size_t before = c->closed[comp] ? (k + n - 1) % n : k - 1;
+            const double *prev = tk_curve_vertex(c, c->offset[comp] + before);
+            const double *next = tk_curve_vertex(c, tk_curve_vertex_index(c, comp, k + 1));
+            double t[3] = {next[0] - prev[0], next[1] - prev[1], next[2] - prev[2]};
+            double tn = tk_norm(t, 3);
+            if (!(tn > 0.0))
+                continue;
+            double speed = r->opt.equalise * mean_grad * (offset[k] - shift) / mean_edge;
+            for (int j = 0; j < 3; j++)
+                u[3 * v + j] += speed * t[j] / tn;
+        }
+    }
+}
+
+/* motion = u + A x with x >= 0 minimising |A x + u|, u = -grad(length)
+ * (and, with `equalise`, the edge-equalising motion); the forces go to the
+ * active set. */
+int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *err)
+{
+    const tk_curve *c = r->shared.curve;
+    size_t n3 = 3 * c->nvert;
+    double *grad = r->motion.grad, *motion = r->motion.motion, *work = r->motion.work;
+    tk_curve_length_gradient(c, grad);
+    for (size_t v = 0; v < c->nvert; v++)
+        if (r->shared.fixed[v])
+            grad[3 * v] = grad[3 * v + 1] = grad[3 * v + 2] = 0.0;
+    for (size_t i = 0; i < n3; i++)
+        motion[i] = -grad[i];
+    if (equalise)
+        add_equalising_motion(r, c, motion);
+    const tk_constraints *set = &r->active.set;
+    size_t ncon = set->struts.count + set->nkinks;
+    double grad_norm = tk_norm(grad, n3);
+    rep->rcond = 1.0;
+    if (ncon == 0) {
+        rep->residual = grad_norm > 0.0 ? 1.0 : 0.0;
+        return TK_OK;
+    }
+    int rc = grow_forces(r, ncon, err);
+    if (rc)
+        return rc;
+    cholmod_sparse *a = NULL;
+    rc = tk_active_matrix(r, c, set, &a, err);
+    if (rc)
+        return rc;
+    for (size_t i = 0; i < n3; i++)
+        work[i] = -motion[i];
+    tk_nnls_report nr;
+    tk_nnls_options nopt = TK_NNLS_OPTIONS_INIT;
+    nopt.warm_start = true;
+    tk_active_guess_forces(r, r->motion.x);
+    rc = tk_nnls_solve(r->shared.nnls, a, work, r->motion.x, &nopt, &nr, err);
+    if (!rc) {
+        rep->rcond = nr.rcond;
+        multiply(a, r->motion.x, work, n3);
+    }
+    cholmod_free_sparse(&a, tk_nnls_common(r->shared.nnls));
+    if (rc)
+        return rc;
+    for (size_t i = 0; i < n3; i++)
+        motion[i] += work[i];
+    /* The residual of the length gradient alone, with the same forces. */
+    double s = 0.0;
+    for (size_t i = 0; i < n3; i++) {
+        double d = -grad[i] + work[i];
+        s += d * d;
+    }
+    rep->residual = grad_norm > 0.0 ? sqrt(s) / grad_norm : 0.0;
+    return tk_active_set_forces(r, r->motion.x, err);
+}
+
+/* The resolved motion of the length gradient alone always shortens the
+ * curve at first order, unless it is 0: by the NNLS optimality conditions
+ * (A x) . motion = 0, so grad . motion = -|motion|^2.  With the equalising
+ * motion added it may not (see stepping.c), and then no short step can
+ * pass the length test. */
+bool tk_motion_descends(const tk_run *r)
+{
+    double slope = 0.0;
+    for (size_t i = 0; i < 3 * r->shared.curve->nvert; i++)
+        slope += r->motion.grad[i] * r->motion.motion[i];
+    return slope < 0.0;
+}

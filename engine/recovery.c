@@ -1,0 +1,180 @@
+/* Error recovery (section 4.6): how far the curve violates its
+ * constraints, and Newton steps back into the feasible set.  It works on
+ * a constraint set of its own, so the step's active set (with the forces
+ * the step reports) is left as it was.  See run.h for the rooms of the
+ * flow. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "run.h"
+#include "tk/geometry.h"
+
+#define MAX_CORRECTIONS 25
+
+void tk_recovery_free(tk_run *r)
+{
+    tk_constraints_free(&r->recovery.violated);
+    free(r->recovery.rhs);
+    free(r->recovery.du);
+}
+
+int tk_recovery_fit(tk_run *r, size_t vertices, tk_error *err)
+{
+    free(r->recovery.du);
+    r->recovery.du = calloc(3 * vertices, sizeof *r->recovery.du);
+    if (!r->recovery.du)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for a run of %zu vertices", vertices);
+    return TK_OK;
+}
+
+/* (tau - closest admissible pair) / tau and (lambda r - minrad) /
+ * (lambda r), the worse of the two. */
+int tk_recovery_violation(const tk_run *r, const tk_curve *c, double *out, tk_error *err)
+{
+    double closest;
+    int rc = tk_strut_finder_closest_pair(r->shared.finder, c, TK_ARC_ADMISSIBLE, r->tau, r->tau,
+                                          &closest, err);
+    if (rc)
+        return rc;
+    double minrad = tk_curve_minrad(c, NULL);
+    double v = fmax((r->tau - closest) / r->tau, (r->min_radius - minrad) / r->min_radius);
+    *out = fmax(v, 0.0);
+    return TK_OK;
+}
+
+/* Scaling about the centroid raises every distance and radius in
+ * proportion: just enough to undo a violation of `worst` (a fraction of
+ * the bound).  The finder is then fitted to the curve. */
+void tk_recovery_rescale(tk_run *r, double worst)
+{
+    tk_curve *c = r->shared.curve;
+    double centre[3], back[3];
+    tk_curve_centroid(c, centre);
+    for (int k = 0; k < 3; k++) {
+        back[k] = centre[k];
+        centre[k] = -centre[k];
+    }
+    tk_curve_translate(c, centre);
+    tk_curve_scale(c, (1.0 + 0.5 * tk_tolerance_correction(r)) / (1.0 - worst));
+    tk_curve_translate(c, back);
+    tk_strut_finder_refit(r->shared.finder, c);
+}
+
+static int grow_rhs(tk_run *r, size_t n, tk_error *err)
+{
+    if (n <= r->recovery.rhs_capacity)
+        return TK_OK;
+    size_t cap = r->recovery.rhs_capacity ? r->recovery.rhs_capacity : 64;
+    while (cap < n)
+        cap *= 2;
+    double *rhs = realloc(r->recovery.rhs, cap * sizeof *rhs);
+    if (!rhs)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for %zu constraints", n);
+    r->recovery.rhs = rhs;
+    r->recovery.rhs_capacity = cap;
+    return TK_OK;
+}
+
+/* Only the violated constraints, each aimed a little inside the feasible
+ * set so rounding does not leave it just violated.  Asking the others to
+ * stay put (R = 0) makes the system inconsistent wherever two constraints
+ * have (nearly) the same gradient and only one is violated (the two edges
+ * at a vertex contact, the two radius functions at a kink): its
+ * minimum-norm answer is then long and useless.  Those that become
+ * violated join next time.  Returns how many, with their deficits in
+ * rhs. */
+static size_t keep_violated(tk_run *r)
+{
+    tk_constraints *set = &r->recovery.violated;
+    double *rhs = r->recovery.rhs;
+    double aim = 0.5 * tk_tolerance_correction(r);
+    size_t nv = 0, nb = 0;
+    for (size_t j = 0; j < set->struts.count; j++) {
+        double deficit = r->tau * (1.0 + aim) - set->struts.items[j].length;
+        if (deficit > 0.0) {
+            set->struts.items[nv] = set->struts.items[j];
+            rhs[nv++] = deficit;
+        }
+    }
+    for (size_t k = 0; k < set->nkinks; k++) {
+        double deficit = r->min_radius * (1.0 + aim) - set->kinks[k].minrad;
+        if (deficit > 0.0) {
+            set->kinks[nb] = set->kinks[k];
+            set->kink_edge[nb] = set->kink_edge[k];
+            rhs[nv + nb++] = deficit;
+        }
+    }
+    set->struts.count = nv;
+    set->nkinks = nb;
+    return nv + nb;
+}
+
+/* Newton steps du solving A_V^T du = -R with minimum norm, R the
+ * violations of the violated constraints V among the active ones, until
+ * every violation is below the correction tolerance.  Each step is damped
+ * until the worst violation falls (near-dependent constraints can make the
+ * regularised solution long); rescaling about the centroid is the last
+ * resort, for small leftovers only. */
+int tk_recovery_correct(tk_run *r, int *iterations, tk_error *err)
+{
+    tk_curve *c = r->shared.curve, *t = r->shared.trial;
+    tk_strut_finder *finder = r->shared.finder;
+    tk_constraints *set = &r->recovery.violated;
+    double *du = r->recovery.du;
+    size_t n3 = 3 * c->nvert;
+    *iterations = 0;
+    tk_strut_finder_refit(finder, c);
+    double worst;
+    int rc = tk_recovery_violation(r, c, &worst, err);
+    for (int it = 0; !rc && worst > tk_tolerance_correction(r) && it < MAX_CORRECTIONS; it++) {
+        rc = tk_active_find(r, c, set, err);
+        if (!rc)
+            rc = grow_rhs(r, set->struts.count + set->nkinks, err);
+        if (rc)
+            return rc;
+        if (set->struts.count + set->nkinks == 0 || keep_violated(r) == 0)
+            break;
+        cholmod_sparse *a = NULL;
+        rc = tk_active_matrix(r, c, set, &a, err);
+        if (rc)
+            return rc;
+        double delta = 0.0;
+        rc = tk_nnls_min_norm(r->shared.nnls, a, r->recovery.rhs, du, &delta, err);
+        cholmod_free_sparse(&a, tk_nnls_common(r->shared.nnls));
+        if (rc)
+            return rc;
+        /* Never move a vertex by more than a tenth of the diameter. */
+        double longest = 0.0;
+        for (size_t v = 0; v < c->nvert; v++)
+            longest = fmax(longest, tk_norm(du + 3 * v, 3));
+        double alpha = longest > 0.1 * r->tau ? 0.1 * r->tau / longest : 1.0;
+        bool improved = false;
+        for (int halving = 0; halving < 12 && !improved; halving++, alpha *= 0.5) {
+            for (size_t i = 0; i < n3; i++)
+                t->xyz[i] = c->xyz[i] + alpha * du[i];
+            tk_strut_finder_refit(finder, t);
+            double trial_worst;
+            rc = tk_recovery_violation(r, t, &trial_worst, err);
+            if (rc)
+                return rc;
+            if (trial_worst < worst) {
+                memcpy(c->xyz, t->xyz, n3 * sizeof *c->xyz);
+                worst = trial_worst;
+                improved = true;
+            }
+        }
+        tk_strut_finder_refit(finder, c);
+        (*iterations)++;
+        if (!improved)
+            break;
+    }
+    if (rc || worst <= tk_tolerance_correction(r))
+        return rc;
+    if (worst > 10.0 * r->opt.overstep_tolerance)
+        return tk_error_set(err, TK_ENUMERIC,
+                            "could not restore the thickness: constraints violated by %.3g of "
+                            "the diameter after %d corrections",
+                            worst, *iterations);
+    tk_recovery_rescale(r, worst);
+    return TK_OK;
+}

@@ -1,0 +1,213 @@
+/* tightknot: the state of a run and the rooms of the flow (private to
+ * engine/; the public API is tk/tighten.h).
+ *
+ * A step of the flow (tighten.c, tk_run_step) goes through the rooms in
+ * this order, each deciding one thing:
+ *
+ *   schedule.c  before the step: a coarse polygon refined, or the polygon
+ *               re-resolved (decided after an earlier step, carried out
+ *               here, so that a step's figures and its curve always
+ *               describe the same polygon)
+ *   active.c    the active set: the struts and kinks that hold the motion
+ *   stepping.c  the step (section 4.5), which asks motion.c for the
+ *               resolved motion (equation 13) and active.c for the
+ *               constraints a step runs into
+ *   schedule.c  polishing: the tolerances shrink when the ropelength all
+ *               but stops falling (or, on a coarse polygon, the next
+ *               level is due)
+ *   recovery.c  error recovery (section 4.6)
+ *   tighten.c   the step's figures, the history, the stop criteria (and
+ *               the schedule's other cues to move on: a stall, a spent
+ *               share of the budget)
+ *
+ * Each room owns the sub-struct named after it: only its file writes it,
+ * the others read.  The shared part (the curve, the trial curve, the strut
+ * finder, the solver) is made by tighten.c and resized by schedule.c
+ * alone, the only room that changes the vertex count; stepping.c and
+ * recovery.c move the curve's coordinates (and every room refits the
+ * finder to the curve it measures).
+ */
+#ifndef TK_ENGINE_RUN_H
+#define TK_ENGINE_RUN_H
+
+#include <math.h>
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "tk/nnls.h"
+#include "tk/struts.h"
+#include "tk/tighten.h"
+
+/* A set of constraints: struts, and kinks with the edge whose radius
+ * function each holds (equation 3 is the minimum of one function per
+ * edge, so a vertex whose edges are about equally long carries two). */
+typedef struct tk_constraints {
+    tk_strut_list struts;
+    tk_kink *kinks;
+    unsigned char *kink_edge;
+    size_t nkinks, kink_capacity;
+} tk_constraints;
+
+/* A kink constraint's force from the last resolution, for the warm start. */
+typedef struct tk_known_kink {
+    size_t comp, vertex;
+    int edge;
+    double force;
+} tk_known_kink;
+
+struct tk_run {
+    /* set at creation, never changed */
+    tk_options opt;
+    double tau;          /* the tube diameter, 2 radius */
+    double min_radius;   /* lambda * radius: the bound on minrad */
+
+    struct {
+        tk_curve *curve;
+        tk_curve *trial;
+        tk_strut_finder *finder;
+        tk_nnls *nnls;
+        bool *fixed;     /* per vertex: end points of open components */
+    } shared;
+
+    struct {             /* active.c */
+        tk_constraints set;        /* this step's active set, with forces */
+        tk_kink *report;           /* one per vertex, forces summed */
+        size_t nreport;
+        tk_strut_list known_struts; /* the last resolution's, sorted, with forces */
+        tk_known_kink *known_kinks;
+        size_t nknown_kinks;
+    } active;
+
+    struct {             /* motion.c */
+        double *grad;    /* 3V: gradient of length */
+        double *motion;  /* 3V: the motion, then the resolved motion */
+        double *work;    /* 3V */
+        double *x;       /* compressions, one per constraint */
+        size_t x_capacity;
+    } motion;
+
+    struct {             /* stepping.c */
+        double step_size;
+        int tiny_steps;
+        bool equalising; /* this step's motion includes the equalising one */
+    } stepping;
+
+    struct {             /* recovery.c */
+        tk_constraints violated;
+        double *rhs;     /* one per violated constraint */
+        size_t rhs_capacity;
+        double *du;      /* 3V: a Newton step */
+    } recovery;
+
+    struct {             /* schedule.c */
+        int polish_level;    /* times the ropelength has all but stopped falling */
+        size_t polish_from;  /* history entries before the last change of
+                                level or resampling */
+        double resolved_at;  /* ropelength at the last re-resolution */
+        double start_ropelength; /* of the input, before any resampling */
+        int coarse_level;    /* halvings of the vertex count still to undo */
+        int coarse_levels;   /* of them at the start */
+        bool move_on;        /* refine before the next step */
+        size_t resampled_from; /* history entries before the last resampling */
+    } schedule;
+
+    struct {             /* tighten.c */
+        tk_step_report latest;
+        tk_step_report *history;
+        size_t nhistory, history_capacity;
+        double *snapshots;
+        long *snapshot_steps;
+        size_t nsnapshots, snapshot_capacity;
+        double started;
+        tk_stop_reason stop;
+        atomic_int cancel;
+        tk_progress_fn progress;
+        void *user;
+    } life;
+};
+
+static inline double tk_norm(const double *v, size_t n)
+{
+    double s = 0.0;
+    for (size_t i = 0; i < n; i++)
+        s += v[i] * v[i];
+    return sqrt(s);
+}
+
+/* ---- active.c ---- */
+
+/* The active constraints of curve c into *set (the finder must be fitted
+ * to c). */
+int tk_active_find(tk_run *r, const tk_curve *c, tk_constraints *set, tk_error *err);
+/* Adds to the active set the constraints a step to `trial` broke that were
+ * not active (the finder fitted to `trial`); *added counts them. */
+int tk_active_expand(tk_run *r, const tk_curve *trial, size_t *added, tk_error *err);
+/* The rigidity matrix of a set at c, the rows of fixed vertices zeroed. */
+int tk_active_matrix(const tk_run *r, const tk_curve *c, const tk_constraints *set,
+                     cholmod_sparse **a, tk_error *err);
+/* The forces x (struts, then kinks) onto the active set, kept for the next
+ * step's warm start. */
+int tk_active_set_forces(tk_run *r, const double *x, tk_error *err);
+/* The warm start: the last forces of the active set's constraints into x. */
+void tk_active_guess_forces(const tk_run *r, double *x);
+/* The kinks as reported (one per vertex, forces summed). */
+int tk_active_report(tk_run *r, tk_error *err);
+/* A new polygon: no active set, no warm start. */
+void tk_active_reset(tk_run *r);
+void tk_active_free(tk_run *r);
+void tk_constraints_free(tk_constraints *set);
+double tk_branch_radius(const tk_curve *c, size_t v, int edge);
+
+/* ---- motion.c ---- */
+
+/* Resolves the motion against the active set (equation 13). */
+int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *err);
+/* Whether the motion shortens the curve at first order. */
+bool tk_motion_descends(const tk_run *r);
+int tk_motion_fit(tk_run *r, size_t vertices, tk_error *err);
+void tk_motion_free(tk_run *r);
+
+/* ---- stepping.c ---- */
+
+/* Resolves the motion and takes the step (section 4.5). */
+int tk_stepping_step(tk_run *r, tk_step_report *rep, tk_error *err);
+/* The step size has been nothing for too many steps. */
+bool tk_stepping_stalled(const tk_run *r);
+void tk_stepping_reset(tk_run *r);
+
+/* ---- recovery.c ---- */
+
+/* Worst violation of the constraints by c as a fraction of the bound (0
+ * when all hold); the finder must be fitted to c. */
+int tk_recovery_violation(const tk_run *r, const tk_curve *c, double *out, tk_error *err);
+/* Corrects the run's curve until no constraint is violated beyond the
+ * correction tolerance (section 4.6); the finder is then fitted to it. */
+int tk_recovery_correct(tk_run *r, int *iterations, tk_error *err);
+/* Scales the curve about its centroid to undo a violation `worst`. */
+void tk_recovery_rescale(tk_run *r, double worst);
+int tk_recovery_fit(tk_run *r, size_t vertices, tk_error *err);
+void tk_recovery_free(tk_run *r);
+
+/* ---- schedule.c ---- */
+
+/* The run's curve from `start`: resampled (to the coarsest level's count)
+ * and autoscaled as the options ask, and everything sized by it. */
+int tk_schedule_start(tk_run *r, const tk_curve *start, tk_error *err);
+/* Resizes the shared part and the rooms' vectors to the run's curve. */
+int tk_schedule_fit(tk_run *r, tk_error *err);
+/* Before a step: refines or re-resolves if due. */
+int tk_schedule_before_step(tk_run *r, tk_error *err);
+/* After a step's motion: polishing (or, on a coarse polygon, moving on). */
+void tk_schedule_watch(tk_run *r);
+/* Refine before the next step; false on the final polygon. */
+bool tk_schedule_move_on(tk_run *r);
+/* On a coarse polygon, whether its share of the step or time budget is
+ * spent. */
+bool tk_schedule_share_spent(const tk_run *r);
+bool tk_schedule_final(const tk_run *r);
+double tk_tolerance_active(const tk_run *r);
+double tk_tolerance_overstep(const tk_run *r);
+double tk_tolerance_correction(const tk_run *r);
+
+#endif

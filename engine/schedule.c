@@ -1,0 +1,309 @@
+/* The schedule: the polygon a run starts from, the tolerances as the run
+ * polishes, coarse to fine and re-resolution.  The only room that changes
+ * the vertex count.  See run.h for the rooms of the flow. */
+#include <stdlib.h>
+
+#include "run.h"
+#include "tk/thickness.h"
+
+/* Each time the ropelength falls by less than POLISH_CHANGE (relative;
+ * shrinking with the tolerances) over POLISH_WINDOW steps, the active
+ * tolerance shrinks by POLISH_FACTOR, at most POLISH_LEVELS times. */
+#define POLISH_WINDOW 200
+#define POLISH_CHANGE 1e-4
+#define POLISH_FACTOR (1.0 / 3.0)
+#define POLISH_LEVELS 4
+/* Coarse to fine: the coarsest polygon has at least this many vertices
+ * per unit ropelength, and at most this many halvings are undone. */
+#define COARSEST_RESOLUTION 2.5
+#define MAX_COARSE_LEVELS 3
+/* The largest ropelength a run starts from.  Autoscaled, such a curve's
+ * coordinates reach about this many diameters, and rounding then moves
+ * them by 1e-16 of that: beyond 1e9 the rounding approaches the
+ * tolerances of the step control (1e-5 of the diameter) and error
+ * recovery fails.  Curves that thin have (nearly) crossed themselves: a
+ * spline through a polygon with a spike loops through the polygon (a
+ * 16-gon with one vertex pulled out: ropelength 48, resampled 1e17). */
+#define START_ROPELENGTH_MAX 1e9
+
+/* The tolerances of this step: the options' while the ropelength falls,
+ * each a third smaller every time it all but stops (polishing).  A
+ * constraint within the active tolerance holds the motion as if it were
+ * in contact: with a slack of up to 3e-4 of the diameter such constraints
+ * kept runs settling about 1e-4 (relative) above their critical points
+ * (3.1 at resolution 5: 32.7719 at 3e-4, 32.7694 at 1e-4, 32.7689 at
+ * 1e-5), while a tolerance that small from the start makes the loose
+ * phase slower (contacts are met mid-step and found by the step control
+ * instead).  The overstep tolerance stays below the active one (a step's
+ * violations must be seen as active next time), the correction tolerance
+ * a tenth of that.  Shrinking them costs step length (steps along curved
+ * constraints grow as the square root of the overstep tolerance), so each
+ * level waits until the ropelength falls by less than the offset the
+ * current one leaves (about a third of its active tolerance, relative):
+ * a run that merely crawls (past a saddle) keeps its step sizes. */
+static double polish_scale(const tk_run *r)
+{
+    return pow(POLISH_FACTOR, r->schedule.polish_level);
+}
+
+double tk_tolerance_active(const tk_run *r)
+{
+    return r->opt.active_tolerance * polish_scale(r);
+}
+
+double tk_tolerance_overstep(const tk_run *r)
+{
+    return fmin(r->opt.overstep_tolerance, tk_tolerance_active(r));
+}
+
+double tk_tolerance_correction(const tk_run *r)
+{
+    return fmin(r->opt.correction_tolerance, 0.1 * tk_tolerance_overstep(r));
+}
+
+/* The thickness of the starting curve, for set-up. */
+static int measure(const tk_curve *c, tk_measure *m, tk_error *err)
+{
+    int rc = tk_thickness_measure(c, NULL, m, err);
+    if (rc == TK_OK && !(m->thickness > 0.0 && isfinite(m->thickness)))
+        rc = tk_error_set(err, TK_EINVAL,
+                          "the curve has no finite thickness (%g): nothing to tighten",
+                          m->thickness);
+    return rc;
+}
+
+/* The resolution of the current coarse level (the option's at the last). */
+static double resolution_now(const tk_run *r)
+{
+    return ldexp(r->opt.resolution, -r->schedule.coarse_level);
+}
+
+bool tk_schedule_final(const tk_run *r)
+{
+    return r->schedule.coarse_level == 0;
+}
+
+/* Everything sized by the curve's vertices: the trial curve, the strut
+ * tree and the rooms' vectors; the active set and the warm start are
+ * dropped (their edge indices refer to the old curve). */
+int tk_schedule_fit(tk_run *r, tk_error *err)
+{
+    const tk_curve *c = r->shared.curve;
+    tk_curve_free(&r->shared.trial);
+    tk_strut_finder_free(&r->shared.finder);
+    int rc = tk_curve_copy(c, &r->shared.trial, err);
+    if (!rc)
+        rc = tk_strut_finder_new(c, &r->shared.finder, err);
+    if (!rc)
+        rc = tk_motion_fit(r, c->nvert, err);
+    if (!rc)
+        rc = tk_recovery_fit(r, c->nvert, err);
+    if (rc)
+        return rc;
+    free(r->shared.fixed);
+    r->shared.fixed = calloc(c->nvert, sizeof *r->shared.fixed);
+    if (!r->shared.fixed)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for a run of %zu vertices", c->nvert);
+    for (size_t comp = 0; comp < c->ncomp; comp++)
+        if (!c->closed[comp]) {
+            r->shared.fixed[c->offset[comp]] = true;
+            r->shared.fixed[c->offset[comp + 1] - 1] = true;
+        }
+    tk_active_reset(r);
+    return TK_OK;
+}
+
+/* The run's curve: a copy of the start, resampled to the resolution (of
+ * the coarsest level) and autoscaled, or refused. */
+static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
+{
+    tk_measure m;
+    tk_curve **curve = &r->shared.curve;
+    int rc = tk_curve_copy(start, curve, err);
+    if (!rc)
+        rc = measure(*curve, &m, err);
+    if (rc)
+        return rc;
+    r->schedule.start_ropelength = m.ropelength;
+    if (!(m.ropelength <= START_ROPELENGTH_MAX))
+        return tk_error_set(err, TK_EINVAL,
+                            "the curve is too thin for its length to tighten in double "
+                            "precision: ropelength %.6g, above %g (does it nearly cross itself?)",
+                            m.ropelength, START_ROPELENGTH_MAX);
+    if (r->opt.resolution > 0.0) {
+        double want = ceil(r->opt.resolution * m.ropelength);
+        if (want > 1e7)
+            return tk_error_set(err, TK_ELIMIT,
+                                "resolution %g at ropelength %.4g asks for %.0f vertices",
+                                r->opt.resolution, m.ropelength, want);
+        int level = 0;
+        if (r->opt.coarse_to_fine && r->opt.snapshot_every == 0)
+            while (level < MAX_COARSE_LEVELS &&
+                   ldexp(r->opt.resolution, -(level + 1)) >= COARSEST_RESOLUTION)
+                level++;
+        r->schedule.coarse_level = r->schedule.coarse_levels = level;
+        want = ceil(resolution_now(r) * m.ropelength);
+        tk_curve *resampled = NULL;
+        rc = tk_curve_resample_total(*curve, (size_t)want, &resampled, err);
+        if (rc)
+            return rc;
+        tk_curve_free(curve);
+        *curve = resampled;
+        rc = measure(*curve, &m, err);
+        if (rc == TK_EINVAL || (rc == TK_OK && !(m.ropelength <= START_ROPELENGTH_MAX)))
+            return tk_error_set(err, TK_EINVAL,
+                                "resampling to %zu vertices (resolution %g) makes the curve "
+                                "(nearly) cross itself (ropelength %.6g, from %.6g): the smooth "
+                                "curve through the vertices loops where they turn sharply; "
+                                "tighten without a resolution first, or add vertices there",
+                                (*curve)->nvert, r->opt.resolution, rc ? INFINITY : m.ropelength,
+                                r->schedule.start_ropelength);
+        if (rc)
+            return rc;
+    }
+    if (r->opt.autoscale) {
+        double factor = r->opt.autoscale_margin * r->tau / m.thickness;
+        tk_curve_scale(*curve, factor);
+        /* A radius far from the curve's own scale can carry it out of the
+         * range the engine measures in. */
+        tk_error why;
+        if (tk_curve_check_range(*curve, &why))
+            return tk_error_set(err, TK_EINVAL,
+                                "autoscale to radius %g scales the curve by %g, out of the "
+                                "engine's range (%s)",
+                                r->opt.radius, factor, why.message);
+    } else if (m.thickness < r->tau * (1.0 - r->opt.overstep_tolerance) ||
+               2.0 * m.minrad < 2.0 * r->min_radius * (1.0 - r->opt.overstep_tolerance)) {
+        return tk_error_set(err, TK_EINVAL,
+                            "the curve's thickness %.6g is below the tube diameter %.6g "
+                            "(or its curvature too high for lambda %g): use autoscale",
+                            m.thickness, r->tau, r->opt.lambda);
+    }
+    return TK_OK;
+}
+
+int tk_schedule_start(tk_run *r, const tk_curve *start, tk_error *err)
+{
+    r->schedule.resolved_at = INFINITY;
+    int rc = prepare_curve(r, start, err);
+    return rc ? rc : tk_schedule_fit(r, err);
+}
+
+/* Resamples the run's curve to `count` vertices along its spline and
+ * scales it about its centroid just enough to be feasible again. */
+static int resample_to(tk_run *r, size_t count, tk_error *err)
+{
+    tk_curve *resampled = NULL;
+    int rc = tk_curve_resample_total(r->shared.curve, count, &resampled, err);
+    if (rc)
+        return rc;
+    tk_curve_free(&r->shared.curve);
+    r->shared.curve = resampled;
+    r->schedule.resolved_at = r->life.latest.ropelength;
+    /* a new polygon, further from its critical point: polishing starts
+     * again from its own history */
+    r->schedule.polish_level = 0;
+    r->schedule.polish_from = r->life.nhistory;
+    r->schedule.resampled_from = r->life.nhistory;
+    rc = tk_schedule_fit(r, err);
+    double worst = 0.0;
+    if (!rc)
+        rc = tk_recovery_violation(r, r->shared.curve, &worst, err);
+    if (rc)
+        return rc;
+    if (worst > 0.0)
+        tk_recovery_rescale(r, worst);
+    tk_stepping_reset(r);
+    return TK_OK;
+}
+
+/* Coarse to fine: a coarse polygon has fewer, longer edges, so each step
+ * is cheaper and the kink constraints far less stiff (their relative
+ * curvature grows like 1 / (theta l)^2); it gets to the neighbourhood of
+ * the tight shape many times faster, past saddles the fine polygon crawls
+ * by (6.3.2 at resolution 2.5: below 58.6 after 34 s; at 5, 67.7 after
+ * 300 s).  Once it has all but stopped tightening (tk_schedule_watch),
+ * stalled, or spent its share of the budget (both judged with the stop
+ * criteria, tighten.c), the vertices are doubled and the finer polygon
+ * starts from there. */
+bool tk_schedule_move_on(tk_run *r)
+{
+    if (r->schedule.coarse_level == 0)
+        return false;
+    r->schedule.move_on = true;
+    return true;
+}
+
+static int refine(tk_run *r, tk_error *err)
+{
+    r->schedule.move_on = false;
+    r->schedule.coarse_level--;
+    double rope =
+        r->opt.re_resolve > 0.0 ? r->life.latest.ropelength : r->schedule.start_ropelength;
+    return resample_to(r, (size_t)ceil(resolution_now(r) * rope), err);
+}
+
+/* A run with a budget of steps or time spends its last share of it on the
+ * final polygon even when a coarse one is still tightening: each level's
+ * share is an equal part of the budget.  A budget too small for that (a
+ * step or two) is overrun by one step per level, so the run still ends on
+ * the polygon of its resolution. */
+bool tk_schedule_share_spent(const tk_run *r)
+{
+    if (r->schedule.coarse_level == 0)
+        return false;
+    const tk_options *o = &r->opt;
+    const tk_step_report *s = &r->life.latest;
+    double spent = 0.0;
+    if (o->max_steps > 0)
+        spent = fmax(spent, (double)s->step / (double)o->max_steps);
+    if (o->max_seconds > 0.0)
+        spent = fmax(spent, s->seconds / o->max_seconds);
+    int levels = r->schedule.coarse_levels;
+    return spent >= (double)(levels - r->schedule.coarse_level + 1) / (double)(levels + 1);
+}
+
+/* Re-resolution during the run: the start was resampled to `resolution`
+ * vertices per unit of ropelength, and as the knot tightens that count
+ * grows finer than asked for.  Finer than needed costs twice: every step
+ * solves for more constraints, and the step the flow can take (explicit
+ * Euler on the length gradient, whose stiffness grows as the edges
+ * shorten, and the overstep control at kinks) shrinks with the edges.
+ * When the ropelength has fallen by the re_resolve fraction since the
+ * last resampling and the count is that much too fine, the curve is
+ * resampled along its spline to ceil(resolution * ropelength) vertices
+ * and scaled about its centroid just enough to be feasible again (costing
+ * as much length, relatively, as the resampling cost thickness). */
+int tk_schedule_before_step(tk_run *r, tk_error *err)
+{
+    const tk_options *o = &r->opt;
+    double rope = r->life.latest.ropelength;
+    if (r->schedule.move_on)
+        return refine(r, err);
+    if (!(o->re_resolve > 0.0) || !(o->resolution > 0.0) || !isfinite(rope))
+        return TK_OK;
+    if (!isfinite(r->schedule.resolved_at)) {
+        r->schedule.resolved_at = rope;
+        return TK_OK;
+    }
+    double want = ceil(resolution_now(r) * rope);
+    if (!(rope < r->schedule.resolved_at * (1.0 - o->re_resolve)) ||
+        !(want < (double)r->shared.curve->nvert * (1.0 - o->re_resolve)))
+        return TK_OK;
+    return resample_to(r, (size_t)want, err);
+}
+
+/* Judged on the history before this step's figures, after its motion and
+ * before its error recovery (which then works to the new tolerances). */
+void tk_schedule_watch(tk_run *r)
+{
+    size_t n = r->life.nhistory;
+    if (!(n > r->schedule.polish_from + POLISH_WINDOW && r->schedule.polish_level < POLISH_LEVELS))
+        return;
+    double before = r->life.history[n - 1 - POLISH_WINDOW].ropelength;
+    double now = r->life.history[n - 1].ropelength;
+    if (before - now < POLISH_CHANGE * polish_scale(r) * now && !tk_schedule_move_on(r)) {
+        r->schedule.polish_level++;
+        r->schedule.polish_from = n;
+    }
+}

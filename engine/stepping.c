@@ -1,0 +1,145 @@
+/* Step control (section 4.5): how far the curve moves along the resolved
+ * motion, the constraints a step runs into, and the step along the
+ * resolved gradient alone when the equalising motion blocks it.  See run.h
+ * for the rooms of the flow. */
+#include <string.h>
+
+#include "run.h"
+
+/* Step sizes below this fraction of the largest allowed count as no step;
+ * this many of them in a row make the run stalled. */
+#define STALL_FRACTION 1e-12
+#define STALL_STEPS 20
+/* A step below this fraction of the largest allowed is tried again
+ * without the equalising motion. */
+#define SHORT_STEP_FRACTION 1e-6
+#define MAX_HALVINGS 50
+#define MAX_EXPANSIONS 8
+#define HALVINGS_BEFORE_EXPANDING 3
+
+void tk_stepping_reset(tk_run *r)
+{
+    r->stepping.step_size = 0.0;
+    r->stepping.tiny_steps = 0;
+}
+
+bool tk_stepping_stalled(const tk_run *r)
+{
+    return r->stepping.tiny_steps >= STALL_STEPS;
+}
+
+static int resolve(tk_run *r, tk_step_report *rep, tk_error *err)
+{
+    return tk_motion_resolve(r, rep, r->stepping.equalising, err);
+}
+
+/* No vertex may move more than a tenth of the diameter or a quarter of
+ * the shortest edge in one step, so no strand can pass through another
+ * between two checks and no edge folds over: the largest step size for the
+ * current motion (0 when nothing moves). */
+static double largest_step(const tk_run *r)
+{
+    const tk_curve *c = r->shared.curve;
+    double fastest = 0.0;
+    for (size_t v = 0; v < c->nvert; v++)
+        fastest = fmax(fastest, tk_norm(r->motion.motion + 3 * v, 3));
+    if (!(fastest > 0.0))
+        return 0.0;
+    double shortest_edge;
+    tk_curve_edge_range(c, &shortest_edge, NULL);
+    return fmin(0.1 * r->tau, 0.25 * shortest_edge) / fastest;
+}
+
+/* The largest step, halving from twice the last one, whose end point
+ * violates no constraint by more than the overstep tolerance.
+ * rep->step_size is the step taken (0 if none was acceptable), *allowed
+ * the largest step the motion allowed. */
+static int take_step(tk_run *r, tk_step_report *rep, double *allowed, tk_error *err)
+{
+    tk_curve *c = r->shared.curve, *t = r->shared.trial;
+    tk_strut_finder *finder = r->shared.finder;
+    const double *motion = r->motion.motion;
+    size_t n3 = 3 * c->nvert;
+    double largest = largest_step(r);
+    *allowed = largest;
+    if (!(largest > 0.0) || !tk_motion_descends(r)) {
+        rep->step_size = 0.0;
+        r->stepping.step_size = 0.0;
+        return TK_OK;
+    }
+    double h = r->stepping.step_size > 0.0 ? fmin(2.0 * r->stepping.step_size, largest)
+                                           : largest / 8.0;
+    double length_before = tk_curve_length(c);
+    int expansions = 0;
+    for (int halving = 0; halving < MAX_HALVINGS; halving++, h *= 0.5) {
+        for (size_t i = 0; i < n3; i++)
+            t->xyz[i] = c->xyz[i] + h * motion[i];
+        tk_strut_finder_refit(finder, t);
+        double worst;
+        int rc = tk_recovery_violation(r, t, &worst, err);
+        if (rc)
+            return rc;
+        if (worst > tk_tolerance_overstep(r) && expansions < MAX_EXPANSIONS &&
+            halving >= HALVINGS_BEFORE_EXPANDING) {
+            /* Constraints the step keeps running into: make them active,
+             * resolve again and retry the same step size.  Not at the first
+             * failure: a shorter step is cheaper than a new resolution, and
+             * usually enough. */
+            size_t added = 0;
+            rc = tk_active_expand(r, t, &added, err);
+            if (rc)
+                return rc;
+            if (added > 0) {
+                expansions++;
+                tk_strut_finder_refit(finder, c);
+                rc = resolve(r, rep, err);
+                if (rc)
+                    return rc;
+                largest = largest_step(r);
+                *allowed = largest;
+                if (!tk_motion_descends(r))
+                    break;
+                h = 2.0 * fmin(h, largest); /* undo this iteration's halving */
+                continue;
+            }
+        }
+        /* The resolved motion shortens the curve to first order; a step
+         * that makes it longer went too far along a curved constraint. */
+        if (worst <= tk_tolerance_overstep(r) && tk_curve_length(t) < length_before) {
+            memcpy(c->xyz, t->xyz, n3 * sizeof *c->xyz);
+            r->stepping.step_size = h;
+            rep->step_size = h;
+            return TK_OK;
+        }
+    }
+    tk_strut_finder_refit(finder, c);
+    rep->step_size = 0.0;
+    r->stepping.step_size = 0.0;
+    return TK_OK;
+}
+
+int tk_stepping_step(tk_run *r, tk_step_report *rep, tk_error *err)
+{
+    r->stepping.equalising = r->opt.equalise > 0.0;
+    int rc = resolve(r, rep, err);
+    double allowed = 0.0;
+    if (!rc)
+        rc = take_step(r, rep, &allowed, err);
+    /* The equalising motion is tangential, but on a polygon it costs
+     * length at first order.  Near a constrained critical point the
+     * resolved gradient is small and that cost can outweigh it, or the
+     * length rises at second order faster than the motion lowers it at
+     * first: the step search then finds nothing (or next to nothing) and
+     * the run would stall short of the critical point.  The step goes
+     * along the resolved gradient alone instead. */
+    if (!rc && r->stepping.equalising && !(rep->step_size >= SHORT_STEP_FRACTION * allowed)) {
+        r->stepping.equalising = false;
+        r->stepping.step_size = 0.0;
+        rc = resolve(r, rep, err);
+        if (!rc)
+            rc = take_step(r, rep, &allowed, err);
+    }
+    r->stepping.tiny_steps =
+        rep->step_size < STALL_FRACTION * allowed ? r->stepping.tiny_steps + 1 : 0;
+    return rc;
+}
