@@ -83,7 +83,7 @@ BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
 .SECONDARY:
 
-.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-service \
+.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-service \
 	lint headers clean fuzz fuzz-bin
 
 WEB_OUT := $(BUILD)/web
@@ -185,13 +185,16 @@ run: deps all
 	@echo "tightknot: starting the service on http://127.0.0.1:$(PORT)/ (Ctrl-C stops it)"
 	$(Q)exec $(DAEMON) $(RUN_ARGS)
 
-bench: bench-struts bench-tighten bench-service
+bench: bench-struts bench-tighten bench-steps bench-service
 
 bench-struts: deps all $(BENCH_BIN)
 	$(Q)$(BUILD)/bench/struts $(CATALOGUE)
 
 bench-tighten: deps all $(BENCH_BIN)
 	$(Q)$(BUILD)/bench/tighten $(CATALOGUE)
+
+bench-steps: deps all $(BENCH_BIN)
+	$(Q)$(BUILD)/bench/steps $(CATALOGUE)
 
 bench-service: deps all
 	$(Q)./bench/service.sh $(BUILD) $(CATALOGUE)

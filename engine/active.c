@@ -102,6 +102,7 @@ static bool has_strut(const tk_strut_list *list, const tk_strut *s)
  * step in proportion to the tolerance. */
 int tk_active_find(tk_run *r, const tk_curve *c, tk_constraints *set, tk_error *err)
 {
+    double t0 = tk_clock();
     tk_strut_list_clear(&set->struts);
     set->nkinks = 0;
     double slack = 1.0 + tk_tolerance_active(r);
@@ -120,6 +121,7 @@ int tk_active_find(tk_run *r, const tk_curve *c, tk_constraints *set, tk_error *
         }
     }
     free(found);
+    r->active.search_seconds += tk_clock() - t0;
     return rc;
 }
 
@@ -130,6 +132,7 @@ int tk_active_expand(tk_run *r, const tk_curve *trial, size_t *added, tk_error *
 {
     const tk_curve *c = r->shared.curve;
     tk_constraints *set = &r->active.set;
+    double t0 = tk_clock();
     *added = 0;
     double floor = 1.0 - tk_tolerance_overstep(r);
     tk_strut_list broken = {0};
@@ -182,25 +185,28 @@ int tk_active_expand(tk_run *r, const tk_curve *trial, size_t *added, tk_error *
         }
     }
     free(bent);
+    r->active.search_seconds += tk_clock() - t0;
     return rc;
 }
 
 /* The rows of fixed vertices are zeroed: those coordinates are not
  * variables. */
-int tk_active_matrix(const tk_run *r, const tk_curve *c, const tk_constraints *set,
+int tk_active_matrix(tk_run *r, const tk_curve *c, const tk_constraints *set,
                      cholmod_sparse **a, tk_error *err)
 {
+    double t0 = tk_clock();
     int rc = tk_rigidity_build_branches(c, set->struts.items, set->struts.count, set->kinks,
                                         set->kink_edge, set->nkinks,
                                         tk_nnls_common(r->shared.nnls), a, err);
-    if (rc)
-        return rc;
-    const int *colp = (*a)->p, *row = (*a)->i;
-    double *val = (*a)->x;
-    for (int k = 0; k < colp[(*a)->ncol]; k++)
-        if (r->shared.fixed[row[k] / 3])
-            val[k] = 0.0;
-    return TK_OK;
+    if (!rc) {
+        const int *colp = (*a)->p, *row = (*a)->i;
+        double *val = (*a)->x;
+        for (int k = 0; k < colp[(*a)->ncol]; k++)
+            if (r->shared.fixed[row[k] / 3])
+                val[k] = 0.0;
+    }
+    r->active.matrix_seconds += tk_clock() - t0;
+    return rc;
 }
 
 static int compare_known_kinks(const void *pa, const void *pb)

@@ -138,7 +138,12 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
     tk_nnls_options nopt = TK_NNLS_OPTIONS_INIT;
     nopt.warm_start = true;
     tk_active_guess_forces(r, r->motion.x);
+    double t0 = tk_clock();
     rc = tk_nnls_solve(r->shared.nnls, a, work, r->motion.x, &nopt, &nr, err);
+    r->motion.nnls_seconds += tk_clock() - t0;
+    r->motion.nnls_solves++;
+    r->motion.nnls_iterations += nr.iterations;
+    r->motion.factorisations += nr.factorisations;
     if (!rc) {
         rep->rcond = nr.rcond;
         multiply(a, r->motion.x, work, n3);

@@ -29,17 +29,18 @@ int tk_recovery_fit(tk_run *r, size_t vertices, tk_error *err)
 
 /* (tau - closest admissible pair) / tau and (lambda r - minrad) /
  * (lambda r), the worse of the two. */
-int tk_recovery_violation(const tk_run *r, const tk_curve *c, double *out, tk_error *err)
+int tk_recovery_violation(tk_run *r, const tk_curve *c, double *out, tk_error *err)
 {
-    double closest;
+    double t0 = tk_clock(), closest;
     int rc = tk_strut_finder_closest_pair(r->shared.finder, c, TK_ARC_ADMISSIBLE, r->tau, r->tau,
                                           &closest, err);
-    if (rc)
-        return rc;
-    double minrad = tk_curve_minrad(c, NULL);
-    double v = fmax((r->tau - closest) / r->tau, (r->min_radius - minrad) / r->min_radius);
-    *out = fmax(v, 0.0);
-    return TK_OK;
+    if (!rc) {
+        double minrad = tk_curve_minrad(c, NULL);
+        double v = fmax((r->tau - closest) / r->tau, (r->min_radius - minrad) / r->min_radius);
+        *out = fmax(v, 0.0);
+    }
+    r->recovery.check_seconds += tk_clock() - t0;
+    return rc;
 }
 
 /* Scaling about the centroid raises every distance and radius in
@@ -115,7 +116,17 @@ static size_t keep_violated(tk_run *r)
  * until the worst violation falls (near-dependent constraints can make the
  * regularised solution long); rescaling about the centroid is the last
  * resort, for small leftovers only. */
+static int correct(tk_run *r, int *iterations, tk_error *err);
+
 int tk_recovery_correct(tk_run *r, int *iterations, tk_error *err)
+{
+    double t0 = tk_clock();
+    int rc = correct(r, iterations, err);
+    r->recovery.seconds += tk_clock() - t0;
+    return rc;
+}
+
+static int correct(tk_run *r, int *iterations, tk_error *err)
 {
     tk_curve *c = r->shared.curve, *t = r->shared.trial;
     tk_strut_finder *finder = r->shared.finder;
@@ -139,7 +150,9 @@ int tk_recovery_correct(tk_run *r, int *iterations, tk_error *err)
         if (rc)
             return rc;
         double delta = 0.0;
+        double t0 = tk_clock();
         rc = tk_nnls_min_norm(r->shared.nnls, a, r->recovery.rhs, du, &delta, err);
+        r->recovery.nnls_seconds += tk_clock() - t0;
         cholmod_free_sparse(&a, tk_nnls_common(r->shared.nnls));
         if (rc)
             return rc;

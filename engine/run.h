@@ -77,6 +77,7 @@ struct tk_run {
         tk_strut_list known_struts; /* the last resolution's, sorted, with forces */
         tk_known_kink *known_kinks;
         size_t nknown_kinks;
+        double search_seconds, matrix_seconds;
     } active;
 
     struct {             /* motion.c */
@@ -85,12 +86,15 @@ struct tk_run {
         double *work;    /* 3V */
         double *x;       /* compressions, one per constraint */
         size_t x_capacity;
+        double nnls_seconds;
+        long nnls_solves, nnls_iterations, factorisations;
     } motion;
 
     struct {             /* stepping.c */
         double step_size;
         int tiny_steps;
         bool equalising; /* this step's motion includes the equalising one */
+        double seconds;
     } stepping;
 
     struct {             /* recovery.c */
@@ -98,6 +102,7 @@ struct tk_run {
         double *rhs;     /* one per violated constraint */
         size_t rhs_capacity;
         double *du;      /* 3V: a Newton step */
+        double seconds, nnls_seconds, check_seconds;
     } recovery;
 
     struct {             /* schedule.c */
@@ -124,8 +129,12 @@ struct tk_run {
         atomic_int cancel;
         tk_progress_fn progress;
         void *user;
+        double seconds;  /* spent in tk_run_new and tk_run_step */
     } life;
 };
+
+/* Monotonic wall time in seconds, for the timing figures. */
+double tk_clock(void);
 
 static inline double tk_norm(const double *v, size_t n)
 {
@@ -144,7 +153,7 @@ int tk_active_find(tk_run *r, const tk_curve *c, tk_constraints *set, tk_error *
  * not active (the finder fitted to `trial`); *added counts them. */
 int tk_active_expand(tk_run *r, const tk_curve *trial, size_t *added, tk_error *err);
 /* The rigidity matrix of a set at c, the rows of fixed vertices zeroed. */
-int tk_active_matrix(const tk_run *r, const tk_curve *c, const tk_constraints *set,
+int tk_active_matrix(tk_run *r, const tk_curve *c, const tk_constraints *set,
                      cholmod_sparse **a, tk_error *err);
 /* The forces x (struts, then kinks) onto the active set, kept for the next
  * step's warm start. */
@@ -180,7 +189,7 @@ void tk_stepping_reset(tk_run *r);
 
 /* Worst violation of the constraints by c as a fraction of the bound (0
  * when all hold); the finder must be fitted to c. */
-int tk_recovery_violation(const tk_run *r, const tk_curve *c, double *out, tk_error *err);
+int tk_recovery_violation(tk_run *r, const tk_curve *c, double *out, tk_error *err);
 /* Corrects the run's curve until no constraint is violated beyond the
  * correction tolerance (section 4.6); the finder is then fitted to it. */
 int tk_recovery_correct(tk_run *r, int *iterations, tk_error *err);

@@ -120,6 +120,7 @@ static int take_step(tk_run *r, tk_step_report *rep, double *allowed, tk_error *
 
 int tk_stepping_step(tk_run *r, tk_step_report *rep, tk_error *err)
 {
+    double t0 = tk_clock();
     r->stepping.equalising = r->opt.equalise > 0.0;
     int rc = resolve(r, rep, err);
     double allowed = 0.0;
@@ -141,5 +142,6 @@ int tk_stepping_step(tk_run *r, tk_step_report *rep, tk_error *err)
     }
     r->stepping.tiny_steps =
         rep->step_size < STALL_FRACTION * allowed ? r->stepping.tiny_steps + 1 : 0;
+    r->stepping.seconds += tk_clock() - t0;
     return rc;
 }

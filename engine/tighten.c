@@ -8,7 +8,7 @@
 #include "run.h"
 #include "tk/thickness.h"
 
-static double now_seconds(void)
+double tk_clock(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -95,7 +95,7 @@ static int record(tk_run *r, tk_step_report *rep, tk_error *err)
     rep->minrad = m.minrad;
     rep->ropelength = m.ropelength;
     rep->vertices = r->shared.curve->nvert;
-    rep->seconds = now_seconds() - r->life.started;
+    rep->seconds = tk_clock() - r->life.started;
     if (r->life.nhistory == r->life.history_capacity) {
         size_t cap = r->life.history_capacity ? 2 * r->life.history_capacity : 256;
         tk_step_report *grown = realloc(r->life.history, cap * sizeof *grown);
@@ -142,7 +142,7 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
     r->tau = 2.0 * opts->radius;
     r->min_radius = opts->lambda * opts->radius;
     atomic_init(&r->life.cancel, 0);
-    r->life.started = now_seconds();
+    r->life.started = tk_clock();
     rc = tk_nnls_new(&r->shared.nnls, err);
     if (!rc)
         rc = tk_schedule_start(r, start, err);
@@ -165,6 +165,7 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
         tk_run_free(&r);
         return rc;
     }
+    r->life.seconds = tk_clock() - r->life.started;
     *out = r;
     return TK_OK;
 }
@@ -216,8 +217,18 @@ static void check_stop(tk_run *r)
     r->life.stop = stop;
 }
 
-/* The rooms in their order (run.h). */
+static int step(tk_run *r, tk_error *err);
+
 int tk_run_step(tk_run *r, tk_error *err)
+{
+    double t0 = tk_clock();
+    int rc = step(r, err);
+    r->life.seconds += tk_clock() - t0;
+    return rc;
+}
+
+/* The rooms in their order (run.h). */
+static int step(tk_run *r, tk_error *err)
 {
     if (r->life.stop == TK_STOP_FAILED)
         return tk_error_set(err, TK_EINVAL, "the run has failed; it cannot step");
@@ -309,6 +320,22 @@ const tk_kink *tk_run_kinks(const tk_run *r, size_t *count)
 {
     *count = r->active.nreport;
     return r->active.report;
+}
+
+void tk_run_timing_get(const tk_run *r, tk_run_timing *out)
+{
+    *out = (tk_run_timing){
+        .search = r->active.search_seconds,
+        .matrix = r->active.matrix_seconds,
+        .nnls = r->motion.nnls_seconds + r->recovery.nnls_seconds,
+        .checks = r->recovery.check_seconds,
+        .total = r->life.seconds,
+        .stepping = r->stepping.seconds,
+        .recovery = r->recovery.seconds,
+        .nnls_solves = r->motion.nnls_solves,
+        .nnls_iterations = r->motion.nnls_iterations,
+        .factorisations = r->motion.factorisations,
+    };
 }
 
 tk_stop_reason tk_run_stop_reason(const tk_run *r)

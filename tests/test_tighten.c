@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "support.h"
 #include "tk/generate.h"
@@ -626,6 +627,53 @@ START_TEST(corrected_steps_report_their_forces)
 }
 END_TEST
 
+static double wall_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* The timing figures add up: the operations and the rooms fit in the
+ * total, which is the run's own share of the wall time measured outside
+ * it (all of it but the loop between steps). */
+START_TEST(timing_accounts_for_the_run)
+{
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_chain(3, 48, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.max_steps = quick() ? 40 : 150;
+    double t0 = wall_seconds();
+    tk_run *run = NULL;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, NULL), TK_OK);
+    ck_assert_int_eq(tk_run_until(run, NULL, NULL), TK_OK);
+    double wall = wall_seconds() - t0;
+    tk_run_timing t;
+    tk_run_timing_get(run, &t);
+    printf("timing: total %.4f of %.4f s: search %.4f, matrix %.4f, nnls %.4f (%ld solves, %ld "
+           "iterations, %ld factorisations), checks %.4f, stepping %.4f, recovery %.4f\n",
+           t.total, wall, t.search, t.matrix, t.nnls, t.nnls_solves, t.nnls_iterations,
+           t.factorisations, t.checks, t.stepping, t.recovery);
+    double parts[] = {t.search, t.matrix, t.nnls, t.checks, t.stepping, t.recovery};
+    for (size_t k = 0; k < sizeof parts / sizeof parts[0]; k++)
+        ck_assert(parts[k] > 0.0 && parts[k] <= t.total);
+    ck_assert(t.search + t.matrix + t.nnls + t.checks <= t.total);
+    ck_assert(t.stepping + t.recovery <= t.total);
+    ck_assert(t.total <= wall && t.total >= 0.5 * wall);
+    /* every step with constraints solves at least once */
+    size_t nh = 0;
+    const tk_step_report *h = tk_run_history(run, &nh);
+    long constrained = 0;
+    for (size_t i = 1; i < nh; i++)
+        constrained += h[i].struts + h[i].kinks > 0;
+    ck_assert_int_ge(t.nnls_solves, constrained / 2);
+    ck_assert_int_ge(t.factorisations, 1);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("tighten");
@@ -634,6 +682,7 @@ int main(void)
     tcase_add_test(tc, start_thinner_than_tube_is_refused);
     tcase_add_test(tc, corrected_steps_report_their_forces);
     tcase_add_test(tc, history_and_snapshots);
+    tcase_add_test(tc, timing_accounts_for_the_run);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
     tcase_add_test(tc, cancellation_stops_within_one_step);

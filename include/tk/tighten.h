@@ -150,6 +150,27 @@ const tk_strut *tk_run_struts(const tk_run *r, size_t *count);
 const tk_kink *tk_run_kinks(const tk_run *r, size_t *count);
 tk_stop_reason tk_run_stop_reason(const tk_run *r);
 
+/* Where a run's wall time went, in seconds.  The first four are the
+ * operations every step repeats, wherever in the flow they happen;
+ * `total` is all of tk_run_new and tk_run_step (the rest of it is the
+ * motion, measuring and recording the figures, and the schedule's
+ * resampling); the two rooms' totals include the operations they called.
+ * So search + matrix + nnls + checks <= total and stepping + recovery <=
+ * total. */
+typedef struct tk_run_timing {
+    double search;       /* active sets: struts and kinks found with the tree */
+    double matrix;       /* rigidity matrices built (equations 6, 7) */
+    double nnls;         /* NNLS solves (equation 13) and minimum-norm solves */
+    double checks;       /* the worst violation of a curve (trial steps,
+                            recovery, each step's figures) */
+    double total;        /* tk_run_new and tk_run_step, all of them */
+    double stepping;     /* step control (section 4.5), everything it called */
+    double recovery;     /* error recovery (section 4.6), everything it called */
+    long nnls_solves, nnls_iterations, factorisations;
+} tk_run_timing;
+
+void tk_run_timing_get(const tk_run *r, tk_run_timing *out);
+
 /* Snapshots: the vertex coordinates (3 * vertices doubles, same component
  * layout as tk_run_curve) every snapshot_every steps. */
 size_t tk_run_snapshot_count(const tk_run *r);

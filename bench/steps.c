@@ -1,0 +1,156 @@
+/* Per-step cost at many contacts: the trefoil tightened first (catalogue
+ * 3.1 at a modest resolution), then resampled to each vertex count,
+ * settled for a few steps (the spline through a tight polygon has sharper
+ * turns than the polygon), scaled so that its struts are in contact and
+ * stepped; prints milliseconds per step with the breakdown of
+ * tk_run_timing (strut search, matrix, NNLS, checks of trial steps, step
+ * control, recovery), the constraints and the NNLS work per step.  Prints
+ * figures; never fails on time.
+ *
+ *   bench/steps [CATALOGUE_DIR] [--warm S] [--settle N] [--steps N]
+ *               [--budget S] [VERTICES ...]
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tk/curve.h"
+#include "tk/tighten.h"
+#include "tk/vect.h"
+
+static void usage(void)
+{
+    fprintf(stderr,
+            "usage: bench/steps [CATALOGUE_DIR] [--warm S] [--settle N] [--steps N]\n"
+            "                   [--budget S] [VERTICES ...]\n"
+            "Tightens catalogue 3.1 at resolution 10 for S seconds (--warm, default 60),\n"
+            "then for each vertex count (default 600 1200 2400 4800): resamples it,\n"
+            "settles it for N steps (--settle, default 40), scales it into contact and\n"
+            "prints milliseconds per step over N steps (--steps, default 5, or as many\n"
+            "as --budget seconds allow, default 300) with where the time went.\n");
+}
+
+static tk_run *start(const tk_curve *c, const tk_options *o)
+{
+    tk_run *run = NULL;
+    tk_error err;
+    if (tk_run_new(c, o, &run, &err) != TK_OK) {
+        fprintf(stderr, "bench/steps: %s\n", err.message);
+        exit(1);
+    }
+    return run;
+}
+
+static void run_to_stop(tk_run *run)
+{
+    tk_error err;
+    if (tk_run_until(run, NULL, &err) != TK_OK) {
+        fprintf(stderr, "bench/steps: %s\n", err.message);
+        exit(1);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    const char *dir = "../shared/catalogue";
+    double warm = 60.0, budget = 300.0;
+    long settle = 40, steps = 5;
+    size_t counts[16], ncounts = 0;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            usage();
+            return 0;
+        } else if (strcmp(argv[i], "--warm") == 0 && i + 1 < argc) {
+            warm = strtod(argv[++i], NULL);
+        } else if (strcmp(argv[i], "--settle") == 0 && i + 1 < argc) {
+            settle = strtol(argv[++i], NULL, 10);
+        } else if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
+            steps = strtol(argv[++i], NULL, 10);
+        } else if (strcmp(argv[i], "--budget") == 0 && i + 1 < argc) {
+            budget = strtod(argv[++i], NULL);
+        } else if (argv[i][0] >= '0' && argv[i][0] <= '9') {
+            if (ncounts < sizeof counts / sizeof counts[0])
+                counts[ncounts++] = strtoul(argv[i], NULL, 10);
+        } else if (argv[i][0] != '-') {
+            dir = argv[i];
+        } else {
+            usage();
+            return 1;
+        }
+    }
+    if (ncounts == 0) {
+        size_t defaults[] = {600, 1200, 2400, 4800};
+        memcpy(counts, defaults, sizeof defaults);
+        ncounts = 4;
+    }
+    char path[4096];
+    snprintf(path, sizeof path, "%s/3.1.vect", dir);
+    tk_curve *loose = NULL;
+    tk_error err;
+    if (tk_vect_read_file(path, NULL, &loose, &err) != TK_OK) {
+        fprintf(stderr, "bench/steps: %s (the catalogue is needed)\n", err.message);
+        return 1;
+    }
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 10;
+    o.max_seconds = warm;
+    tk_run *run = start(loose, &o);
+    run_to_stop(run);
+    tk_curve *tight = NULL;
+    if (tk_curve_copy(tk_run_curve(run), &tight, &err) != TK_OK)
+        return 1;
+    printf("trefoil 3.1 tightened for %.0f s at resolution 10: ropelength %.6f, %zu vertices\n",
+           warm, tk_run_latest(run)->ropelength, tight->nvert);
+    tk_run_free(&run);
+
+    printf("\n%8s %7s %6s %9s %10s | %8s %8s %8s %8s %8s %8s | %6s %6s\n", "vertices", "struts",
+           "kinks", "ms/step", "ropelength", "search", "matrix", "nnls", "checks", "stepping",
+           "recovery", "iter", "facts");
+    for (size_t k = 0; k < ncounts; k++) {
+        tk_curve *resampled = NULL, *settled = NULL;
+        if (tk_curve_resample_total(tight, counts[k], &resampled, &err) != TK_OK) {
+            fprintf(stderr, "bench/steps: %s\n", err.message);
+            return 1;
+        }
+        tk_options s = TK_OPTIONS_INIT;
+        s.autoscale = true;
+        s.max_steps = settle;
+        s.max_seconds = budget;
+        run = start(resampled, &s);
+        run_to_stop(run);
+        tk_curve_copy(tk_run_curve(run), &settled, &err);
+        tk_run_free(&run);
+        /* just inside the active tolerance: every contact is a constraint
+         * from the first step */
+        s.autoscale_margin = 1.00001;
+        s.max_steps = steps;
+        run = start(settled, &s);
+        tk_run_timing before;
+        tk_run_timing_get(run, &before);
+        run_to_stop(run);
+        tk_run_timing t;
+        tk_run_timing_get(run, &t);
+        const tk_step_report *last = tk_run_latest(run);
+        double n = (double)(last->step > 0 ? last->step : 1);
+        double ms = 1e3 / n;
+        printf("%8zu %7zu %6zu %9.1f %10.6f | %8.1f %8.1f %8.1f %8.1f %8.1f %8.1f | %6.1f %6.1f\n",
+               settled->nvert, last->struts, last->kinks, ms * (t.total - before.total),
+               last->ropelength, ms * (t.search - before.search),
+               ms * (t.matrix - before.matrix), ms * (t.nnls - before.nnls),
+               ms * (t.checks - before.checks), ms * (t.stepping - before.stepping),
+               ms * (t.recovery - before.recovery),
+               (double)(t.nnls_iterations - before.nnls_iterations) / n,
+               (double)(t.factorisations - before.factorisations) / n);
+        fflush(stdout);
+        tk_run_free(&run);
+        tk_curve_free(&resampled);
+        tk_curve_free(&settled);
+    }
+    printf("(columns after ropelength: milliseconds per step; stepping includes the motion's\n"
+           " matrix and NNLS solves and its searches and checks; iter and facts: NNLS pivoting\n"
+           " iterations and Cholesky factorisations per step)\n");
+    tk_curve_free(&tight);
+    tk_curve_free(&loose);
+    return 0;
+}
