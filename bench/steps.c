@@ -104,8 +104,8 @@ int main(int argc, char **argv)
            warm, tk_run_latest(run)->ropelength, tight->nvert);
     tk_run_free(&run);
 
-    printf("\n%8s %7s %6s %9s %10s | %8s %8s %8s %8s %8s %8s | %6s %6s\n", "vertices", "struts",
-           "kinks", "ms/step", "ropelength", "search", "matrix", "nnls", "checks", "stepping",
+    printf("\n%8s %7s %6s %6s %9s %10s | %8s %8s %8s %8s %8s %8s | %6s %6s\n", "vertices",
+           "struts", "forced", "kinks", "ms/step", "ropelength", "search", "matrix", "nnls", "checks", "stepping",
            "recovery", "iter", "facts");
     for (size_t k = 0; k < ncounts; k++) {
         tk_curve *resampled = NULL, *settled = NULL;
@@ -134,8 +134,13 @@ int main(int argc, char **argv)
         const tk_step_report *last = tk_run_latest(run);
         double n = (double)(last->step > 0 ? last->step : 1);
         double ms = 1e3 / n;
-        printf("%8zu %7zu %6zu %9.1f %10.6f | %8.1f %8.1f %8.1f %8.1f %8.1f %8.1f | %6.1f %6.1f\n",
-               settled->nvert, last->struts, last->kinks, ms * (t.total - before.total),
+        size_t ns = 0, forced = 0;
+        const tk_strut *struts = tk_run_struts(run, &ns);
+        for (size_t j = 0; j < ns; j++)
+            forced += struts[j].force > 0.0;
+        printf("%8zu %7zu %6zu %6zu %9.1f %10.6f | %8.1f %8.1f %8.1f %8.1f %8.1f %8.1f | %6.1f "
+               "%6.1f\n",
+               settled->nvert, last->struts, forced, last->kinks, ms * (t.total - before.total),
                last->ropelength, ms * (t.search - before.search),
                ms * (t.matrix - before.matrix), ms * (t.nnls - before.nnls),
                ms * (t.checks - before.checks), ms * (t.stepping - before.stepping),
@@ -147,8 +152,9 @@ int main(int argc, char **argv)
         tk_curve_free(&resampled);
         tk_curve_free(&settled);
     }
-    printf("(columns after ropelength: milliseconds per step; stepping includes the motion's\n"
-           " matrix and NNLS solves and its searches and checks; iter and facts: NNLS pivoting\n"
+    printf("(forced: struts with a positive force at the last step; the columns after\n"
+           " ropelength are milliseconds per step, stepping including the motion's matrix\n"
+           " and NNLS solves and its searches and checks; iter and facts: NNLS pivoting\n"
            " iterations and Cholesky factorisations per step)\n");
     tk_curve_free(&tight);
     tk_curve_free(&loose);
