@@ -29,21 +29,6 @@ int tk_motion_fit(tk_run *r, size_t vertices, tk_error *err)
     return TK_OK;
 }
 
-static int grow_forces(tk_run *r, size_t n, tk_error *err)
-{
-    if (n <= r->motion.x_capacity)
-        return TK_OK;
-    size_t cap = r->motion.x_capacity ? r->motion.x_capacity : 64;
-    while (cap < n)
-        cap *= 2;
-    double *x = realloc(r->motion.x, cap * sizeof *x);
-    if (!x)
-        return tk_error_set(err, TK_ENOMEM, "out of memory for %zu constraints", n);
-    r->motion.x = x;
-    r->motion.x_capacity = cap;
-    return TK_OK;
-}
-
 /* out = A x (3V entries). */
 static void multiply(const cholmod_sparse *a, const double *x, double *out, size_t rows)
 {
@@ -125,7 +110,7 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
         rep->residual = grad_norm > 0.0 ? 1.0 : 0.0;
         return TK_OK;
     }
-    int rc = grow_forces(r, ncon, err);
+    int rc = tk_grow_doubles(&r->motion.x, &r->motion.x_capacity, ncon, err);
     if (rc)
         return rc;
     cholmod_sparse *a = NULL;

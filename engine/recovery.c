@@ -61,21 +61,6 @@ void tk_recovery_rescale(tk_run *r, double worst)
     tk_strut_finder_refit(r->shared.finder, c);
 }
 
-static int grow_rhs(tk_run *r, size_t n, tk_error *err)
-{
-    if (n <= r->recovery.rhs_capacity)
-        return TK_OK;
-    size_t cap = r->recovery.rhs_capacity ? r->recovery.rhs_capacity : 64;
-    while (cap < n)
-        cap *= 2;
-    double *rhs = realloc(r->recovery.rhs, cap * sizeof *rhs);
-    if (!rhs)
-        return tk_error_set(err, TK_ENOMEM, "out of memory for %zu constraints", n);
-    r->recovery.rhs = rhs;
-    r->recovery.rhs_capacity = cap;
-    return TK_OK;
-}
-
 /* Only the violated constraints, each aimed a little inside the feasible
  * set so rounding does not leave it just violated.  Asking the others to
  * stay put (R = 0) makes the system inconsistent wherever two constraints
@@ -140,7 +125,8 @@ static int correct(tk_run *r, int *iterations, tk_error *err)
     for (int it = 0; !rc && worst > tk_tolerance_correction(r) && it < MAX_CORRECTIONS; it++) {
         rc = tk_active_find(r, c, set, err);
         if (!rc)
-            rc = grow_rhs(r, set->struts.count + set->nkinks, err);
+            rc = tk_grow_doubles(&r->recovery.rhs, &r->recovery.rhs_capacity,
+                                 set->struts.count + set->nkinks, err);
         if (rc)
             return rc;
         if (set->struts.count + set->nkinks == 0 || keep_violated(r) == 0)

@@ -34,6 +34,7 @@
 #include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdlib.h>
 
 #include "tk/nnls.h"
 #include "tk/struts.h"
@@ -135,6 +136,22 @@ struct tk_run {
 
 /* Monotonic wall time in seconds, for the timing figures. */
 double tk_clock(void);
+
+/* Grows *v (capacity *cap) to hold n doubles, doubling from 64. */
+static inline int tk_grow_doubles(double **v, size_t *cap, size_t n, tk_error *err)
+{
+    if (n <= *cap)
+        return TK_OK;
+    size_t want = *cap ? *cap : 64;
+    while (want < n)
+        want *= 2;
+    double *grown = realloc(*v, want * sizeof *grown);
+    if (!grown)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for %zu constraints", n);
+    *v = grown;
+    *cap = want;
+    return TK_OK;
+}
 
 static inline double tk_norm(const double *v, size_t n)
 {

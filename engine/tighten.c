@@ -182,8 +182,9 @@ void tk_run_cancel(tk_run *r)
 }
 
 /* The first criterion met, in the order cancellation, budget,
- * convergence (a run's stop so far stands when none is); a stall on the final polygon stops the run, and on a
- * coarse one (as a spent share of the budget) moves the schedule on. */
+ * convergence (a run's stop so far stands when none is).  A stall on the
+ * final polygon stops the run; on a coarse one it moves the schedule on,
+ * as a spent share of the budget does. */
 static void check_stop(tk_run *r)
 {
     const tk_options *o = &r->opt;
