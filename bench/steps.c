@@ -119,7 +119,10 @@ int main(int argc, char **argv)
         s.max_seconds = budget;
         run = start(resampled, &s);
         run_to_stop(run);
-        tk_curve_copy(tk_run_curve(run), &settled, &err);
+        if (tk_curve_copy(tk_run_curve(run), &settled, &err) != TK_OK) {
+            fprintf(stderr, "bench/steps: %s\n", err.message);
+            return 1;
+        }
         tk_run_free(&run);
         /* just inside the active tolerance: every contact is a constraint
          * from the first step */

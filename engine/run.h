@@ -94,7 +94,6 @@ struct tk_run {
     struct {             /* stepping.c */
         double step_size;
         int tiny_steps;
-        bool equalising; /* this step's motion includes the equalising one */
         double seconds;
     } stepping;
 

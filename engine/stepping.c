@@ -28,11 +28,6 @@ bool tk_stepping_stalled(const tk_run *r)
     return r->stepping.tiny_steps >= STALL_STEPS;
 }
 
-static int resolve(tk_run *r, tk_step_report *rep, tk_error *err)
-{
-    return tk_motion_resolve(r, rep, r->stepping.equalising, err);
-}
-
 /* No vertex may move more than a tenth of the diameter or a quarter of
  * the shortest edge in one step, so no strand can pass through another
  * between two checks and no edge folds over: the largest step size for the
@@ -53,8 +48,10 @@ static double largest_step(const tk_run *r)
 /* The largest step, halving from twice the last one, whose end point
  * violates no constraint by more than the overstep tolerance.
  * rep->step_size is the step taken (0 if none was acceptable), *allowed
- * the largest step the motion allowed. */
-static int take_step(tk_run *r, tk_step_report *rep, double *allowed, tk_error *err)
+ * the largest step the motion allowed; a resolution after new constraints
+ * keeps the motion's `equalising`. */
+static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *allowed,
+                     tk_error *err)
 {
     tk_curve *c = r->shared.curve, *t = r->shared.trial;
     tk_strut_finder *finder = r->shared.finder;
@@ -92,7 +89,7 @@ static int take_step(tk_run *r, tk_step_report *rep, double *allowed, tk_error *
             if (added > 0) {
                 expansions++;
                 tk_strut_finder_refit(finder, c);
-                rc = resolve(r, rep, err);
+                rc = tk_motion_resolve(r, rep, equalising, err);
                 if (rc)
                     return rc;
                 largest = largest_step(r);
@@ -121,11 +118,11 @@ static int take_step(tk_run *r, tk_step_report *rep, double *allowed, tk_error *
 int tk_stepping_step(tk_run *r, tk_step_report *rep, tk_error *err)
 {
     double t0 = tk_clock();
-    r->stepping.equalising = r->opt.equalise > 0.0;
-    int rc = resolve(r, rep, err);
+    bool equalising = r->opt.equalise > 0.0;
+    int rc = tk_motion_resolve(r, rep, equalising, err);
     double allowed = 0.0;
     if (!rc)
-        rc = take_step(r, rep, &allowed, err);
+        rc = take_step(r, rep, equalising, &allowed, err);
     /* The equalising motion is tangential, but on a polygon it costs
      * length at first order.  Near a constrained critical point the
      * resolved gradient is small and that cost can outweigh it, or the
@@ -133,12 +130,11 @@ int tk_stepping_step(tk_run *r, tk_step_report *rep, tk_error *err)
      * first: the step search then finds nothing (or next to nothing) and
      * the run would stall short of the critical point.  The step goes
      * along the resolved gradient alone instead. */
-    if (!rc && r->stepping.equalising && !(rep->step_size >= SHORT_STEP_FRACTION * allowed)) {
-        r->stepping.equalising = false;
+    if (!rc && equalising && !(rep->step_size >= SHORT_STEP_FRACTION * allowed)) {
         r->stepping.step_size = 0.0;
-        rc = resolve(r, rep, err);
+        rc = tk_motion_resolve(r, rep, false, err);
         if (!rc)
-            rc = take_step(r, rep, &allowed, err);
+            rc = take_step(r, rep, false, &allowed, err);
     }
     r->stepping.tiny_steps =
         rep->step_size < STALL_FRACTION * allowed ? r->stepping.tiny_steps + 1 : 0;
