@@ -36,6 +36,7 @@ const char *tk_status_name(int code)
     case TK_ELIMIT: return "limit exceeded";
     case TK_ENOTFOUND: return "not found";
     case TK_EBUSY: return "busy";
+    case TK_ETYPE: return "knot type changed";
     default: return "unknown error";
     }
 }

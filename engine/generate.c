@@ -14,6 +14,8 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+#include "rng.h"
+
 /* Counts beyond which a generator refuses: the VECT reader's default
  * limits (TK_VECT_LIMITS_INIT), so that every generated curve reads back. */
 #define MAX_TOTAL_VERTICES ((size_t)10000000)
@@ -281,4 +283,109 @@ int tk_generate_chain(size_t k, size_t vertices, tk_curve **out,
         }
     }
     return TK_OK;
+}
+
+int tk_generate_figure_eight(size_t vertices, tk_curve **out, tk_error *err)
+{
+    *out = NULL;
+    size_t n;
+    int rc = check_counts(vertices, 200, 1, &n, err);
+    if (rc)
+        return rc;
+    /* Four turns of the fastest angle (4t): below 2 * 4 + 1 vertices a
+     * step passes pi and the polygon loses the curve's winding; at 48
+     * vertices a brute force check finds it embedded with room. */
+    if (n < 48)
+        return tk_error_set(err, TK_EINVAL,
+                            "the figure-eight needs at least 48 vertices to be embedded "
+                            "(asked for %zu)", n);
+    rc = new_closed(1, n, out, err);
+    if (rc)
+        return rc;
+    for (size_t i = 0; i < n; i++) {
+        double c2, s2, c3, s3, c4, s4;
+        unit_circle(2 * i % n, n, &c2, &s2);
+        unit_circle(3 * i % n, n, &c3, &s3);
+        unit_circle(4 * i % n, n, &c4, &s4);
+        double *v = tk_curve_vertex(*out, i);
+        v[0] = (2.0 + c2) * c3;
+        v[1] = (2.0 + c2) * s3;
+        v[2] = s4;
+    }
+    return TK_OK;
+}
+
+/* Where arclength s lies on component comp of c (s in [0, its length)). */
+static void point_at(const tk_curve *c, size_t comp, double s, double p[3])
+{
+    size_t edges = tk_curve_comp_edges(c, comp);
+    for (size_t e = 0; e < edges; e++) {
+        double len = tk_curve_edge_length(c, comp, e);
+        if (s <= len || e + 1 == edges) {
+            const double *a = tk_curve_vertex(c, tk_curve_vertex_index(c, comp, e));
+            const double *b = tk_curve_vertex(c, tk_curve_vertex_index(c, comp, e + 1));
+            double t = len > 0.0 ? fmin(1.0, fmax(0.0, s / len)) : 0.0;
+            for (int d = 0; d < 3; d++)
+                p[d] = a[d] + t * (b[d] - a[d]);
+            return;
+        }
+        s -= len;
+    }
+}
+
+int tk_generate_disguise(const tk_curve *src, unsigned long long seed, double perturbation,
+                         tk_curve **out, tk_error *err)
+{
+    *out = NULL;
+    if (!(perturbation >= 0.0 && perturbation <= 1.0))
+        return tk_error_set(err, TK_EINVAL, "the perturbation must be in [0, 1] (got %g)",
+                            perturbation);
+    int rc = tk_curve_validate(src, err);
+    if (!rc)
+        rc = tk_curve_copy(src, out, err);
+    if (rc)
+        return rc;
+    tk_curve *c = *out;
+    uint64_t state = seed;
+    for (size_t comp = 0; comp < c->ncomp; comp++) {
+        size_t n = tk_curve_comp_vertices(c, comp);
+        size_t edges = tk_curve_comp_edges(c, comp);
+        double length = tk_curve_comp_length(src, comp);
+        double mean_edge = length / (double)edges;
+        double phase = 2.0 * M_PI * tk_rng_uniform(&state);
+        /* s(u) = L (u + 0.3 (sin(2 pi u + phase) - sin(phase)) / (2 pi))
+         * is increasing (its slope is L (1 + 0.3 cos) > 0) from s(0) = 0 to
+         * s(1) = L, so an open component keeps its ends. */
+        for (size_t k = 0; k < n; k++) {
+            double u = (double)k / (double)edges;
+            double s = length * (u + 0.3 * (sin(2.0 * M_PI * u + phase) - sin(phase)) /
+                                         (2.0 * M_PI));
+            if (!c->closed[comp] && k + 1 == n)
+                s = length;
+            point_at(src, comp, s, tk_curve_vertex(c, c->offset[comp] + k));
+        }
+        for (size_t k = 0; k < n; k++) {
+            if (!c->closed[comp] && (k == 0 || k + 1 == n))
+                continue;
+            double *v = tk_curve_vertex(c, c->offset[comp] + k);
+            for (int d = 0; d < 3; d++)
+                v[d] += perturbation * mean_edge * tk_rng_normal(&state);
+        }
+    }
+    /* A uniformly random rotation: a unit quaternion with normal
+     * coordinates. */
+    double q[4], norm = 0.0;
+    for (int d = 0; d < 4; d++) {
+        q[d] = tk_rng_normal(&state);
+        norm += q[d] * q[d];
+    }
+    norm = sqrt(norm);
+    for (int d = 0; d < 4; d++)
+        q[d] /= norm;
+    double w = q[0], x = q[1], y = q[2], z = q[3];
+    double rot[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+                     2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+                     2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+    tk_curve_rotate(c, rot);
+    return tk_curve_validate(c, err);
 }

@@ -2,8 +2,12 @@
 #include "tk/invariants.h"
 
 #include <math.h>
+#include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
+#include "rng.h"
 #include "tk/geometry.h"
 
 /* The linking integral of two polygons is exact within rounding: a sum
@@ -97,6 +101,8 @@ int tk_linking_number(const tk_curve *c, size_t a, size_t b, long *lk, double *g
 /* A crossing this close (in edge parameter) to a vertex, or edges this
  * close to parallel, make the projection not generic: another is tried. */
 #define GENERIC_MARGIN 1e-9
+/* Generic projections compared for the fewest crossings. */
+#define DIAGRAMS_COMPARED 3
 /* The determinant is computed modulo these primes (2^61 - 1 and
  * 2^59 - 55): two residues that agree on a value below 2^60 in magnitude
  * are that value. */
@@ -106,27 +112,15 @@ int tk_linking_number(const tk_curve *c, size_t a, size_t b, long *lk, double *g
 typedef struct crossing {
     double under; /* position along the knot (edge index + parameter) */
     double over;
+    int sign;     /* +1 when the under strand passes from right to left
+                     of the over strand, looking down the projection */
 } crossing;
-
-/* splitmix64: a direction from a seed, without shared state. */
-static unsigned long long mix(unsigned long long *s)
-{
-    unsigned long long z = (*s += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
 
 /* An orthonormal frame (e1, e2 spanning the picture, e3 the height) from
  * a direction uniform on the sphere. */
-static void frame(unsigned long long *s, double e1[3], double e2[3], double e3[3])
+static void frame(uint64_t *s, double e1[3], double e2[3], double e3[3])
 {
-    double u = (double)(mix(s) >> 11) / 9007199254740992.0;
-    double v = (double)(mix(s) >> 11) / 9007199254740992.0;
-    double z = 2.0 * u - 1.0, r = sqrt(fmax(0.0, 1.0 - z * z)), phi = 2.0 * M_PI * v;
-    e3[0] = r * cos(phi);
-    e3[1] = r * sin(phi);
-    e3[2] = z;
+    tk_rng_direction(s, e3);
     double a[3] = {fabs(e3[0]) < 0.9 ? 1.0 : 0.0, fabs(e3[0]) < 0.9 ? 0.0 : 1.0, 0.0};
     unit_normal(e3, a, e1);
     tk_cross3(e3, e1, e2);
@@ -195,6 +189,8 @@ static int find_crossings(const tk_curve *c, size_t comp, const double e1[3], co
             double pi = (double)i + s, pj = (double)j + t;
             list[m].over = zi > zj ? pi : pj;
             list[m].under = zi > zj ? pj : pi;
+            /* (over direction x under direction) . e3; den = r x s */
+            list[m].sign = (zi > zj) == (den > 0.0) ? 1 : -1;
             m++;
         }
     }
@@ -290,26 +286,64 @@ static long long symmetric(unsigned long long r, unsigned long long p)
     return r > p / 2 ? -(long long)(p - r) : (long long)r;
 }
 
-int tk_knot_determinant(const tk_curve *c, size_t comp, unsigned long long seed, long long *det,
-                        size_t *crossings, tk_error *err)
+/* A diagram of closed component comp: the crossings of the fewest-
+ * crossing projection among the first DIAGRAMS_COMPARED generic ones
+ * (drawn from seed), sorted along the knot by their undercrossings.  The
+ * invariants' cost grows with the crossings, not the vertices. */
+static int diagram(const tk_curve *c, size_t comp, unsigned long long seed, crossing **out,
+                   size_t *count, tk_error *err)
 {
+    *out = NULL;
+    *count = 0;
     if (comp >= c->ncomp || !c->closed[comp])
-        return tk_error_set(err, TK_EINVAL, "the determinant needs a closed component (%zu)",
+        return tk_error_set(err, TK_EINVAL, "a knot invariant needs a closed component (%zu)",
                             comp);
-    crossing *x = NULL;
-    size_t m = 0;
-    int rc = TK_ENUMERIC;
-    unsigned long long state = seed;
-    for (int attempt = 0; attempt < PROJECTION_TRIES && rc == TK_ENUMERIC; attempt++) {
+    uint64_t state = seed;
+    int generic = 0;
+    for (int attempt = 0; attempt < PROJECTION_TRIES && generic < DIAGRAMS_COMPARED; attempt++) {
         double e1[3], e2[3], e3[3];
         frame(&state, e1, e2, e3);
-        rc = find_crossings(c, comp, e1, e2, e3, &x, &m, err);
+        crossing *x = NULL;
+        size_t m = 0;
+        int rc = find_crossings(c, comp, e1, e2, e3, &x, &m, err);
+        if (rc == TK_ENUMERIC)
+            continue;
+        if (rc) {
+            free(*out);
+            *out = NULL;
+            return rc;
+        }
+        if (generic++ == 0 || m < *count) {
+            free(*out);
+            *out = x;
+            *count = m;
+        } else {
+            free(x);
+        }
     }
-    if (rc == TK_ENUMERIC)
+    if (!generic)
         return tk_error_set(err, TK_ENUMERIC,
                             "no generic projection of component %zu in %d tries: strands (nearly) "
                             "meet",
                             comp, PROJECTION_TRIES);
+    if (*count > TK_INVARIANT_MAX_CROSSINGS) {
+        free(*out);
+        *out = NULL;
+        return tk_error_set(err, TK_ELIMIT,
+                            "component %zu has %zu crossings in its simplest projection found, "
+                            "more than the %d its invariants are computed for",
+                            comp, *count, TK_INVARIANT_MAX_CROSSINGS);
+    }
+    qsort(*out, *count, sizeof **out, by_under);
+    return TK_OK;
+}
+
+int tk_knot_determinant(const tk_curve *c, size_t comp, unsigned long long seed, long long *det,
+                        size_t *crossings, tk_error *err)
+{
+    crossing *x = NULL;
+    size_t m = 0;
+    int rc = diagram(c, comp, seed, &x, &m, err);
     if (rc)
         return rc;
     if (crossings)
@@ -320,7 +354,6 @@ int tk_knot_determinant(const tk_curve *c, size_t comp, unsigned long long seed,
         *det = 1;
         return TK_OK;
     }
-    qsort(x, m, sizeof *x, by_under);
     size_t k = m - 1; /* the minor without the last row and column */
     long long *entries = calloc(m * m, sizeof *entries);
     unsigned long long *work = malloc(k * k * sizeof *work);
@@ -361,5 +394,323 @@ int tk_knot_determinant(const tk_curve *c, size_t comp, unsigned long long seed,
                             "the determinant of component %zu exceeds 2^59 (%zu crossings)", comp,
                             m);
     *det = va < 0 ? -va : va;
+    return TK_OK;
+}
+
+/* ---- the Alexander polynomial ---- */
+
+/* Arithmetic modulo the Mersenne prime 2^61 - 1 (PRIME_A), reduced
+ * without division. */
+static uint64_t mul61(uint64_t a, uint64_t b)
+{
+    unsigned __int128 z = (unsigned __int128)a * b;
+    uint64_t r = (uint64_t)(z & PRIME_A) + (uint64_t)(z >> 61);
+    while (r >= PRIME_A)
+        r -= PRIME_A;
+    return r;
+}
+
+static uint64_t inv61(uint64_t a)
+{
+    uint64_t r = 1;
+    for (uint64_t e = PRIME_A - 2; e; e >>= 1, a = mul61(a, a))
+        if (e & 1)
+            r = mul61(r, a);
+    return r;
+}
+
+static uint64_t mod61(long long v)
+{
+    long long r = v % (long long)PRIME_A;
+    return (uint64_t)(r < 0 ? r + (long long)PRIME_A : r);
+}
+
+/* The determinant of the k x k matrix a (residues, row major,
+ * overwritten) modulo 2^61 - 1. */
+static uint64_t det61(uint64_t *a, size_t k)
+{
+    uint64_t det = 1;
+    for (size_t col = 0; col < k; col++) {
+        size_t pivot = col;
+        while (pivot < k && a[pivot * k + col] == 0)
+            pivot++;
+        if (pivot == k)
+            return 0;
+        if (pivot != col) {
+            for (size_t j = col; j < k; j++) {
+                uint64_t t = a[col * k + j];
+                a[col * k + j] = a[pivot * k + j];
+                a[pivot * k + j] = t;
+            }
+            det = det ? PRIME_A - det : 0;
+        }
+        det = mul61(det, a[col * k + col]);
+        uint64_t inv = inv61(a[col * k + col]);
+        for (size_t r = col + 1; r < k; r++) {
+            uint64_t f = mul61(a[r * k + col], inv);
+            if (!f)
+                continue;
+            for (size_t j = col; j < k; j++) {
+                uint64_t sub = mul61(f, a[col * k + j]);
+                a[r * k + j] = a[r * k + j] >= sub ? a[r * k + j] - sub
+                                                    : a[r * k + j] + PRIME_A - sub;
+            }
+        }
+    }
+    return det;
+}
+
+/* The polynomial of degree < m through (t_j, v_j), t_j = j + 2, modulo
+ * 2^61 - 1, as coefficients of 1, t, ... (Newton's divided differences,
+ * then expanded): O(m^2). */
+static void interpolate61(uint64_t *v, size_t m, uint64_t *coeff)
+{
+    for (size_t level = 1; level < m; level++)
+        for (size_t j = m - 1; j >= level; j--) {
+            uint64_t num = v[j] >= v[j - 1] ? v[j] - v[j - 1] : v[j] + PRIME_A - v[j - 1];
+            v[j] = mul61(num, inv61((uint64_t)level)); /* t_j - t_{j-level} = level */
+        }
+    /* Horner on the Newton form: p = v0 + (t - t0)(v1 + (t - t1)(...)) */
+    for (size_t i = 0; i < m; i++)
+        coeff[i] = 0;
+    for (size_t j = m; j-- > 0;) {
+        /* coeff <- coeff * (t - t_j) + v_j */
+        uint64_t tj = (uint64_t)j + 2;
+        for (size_t i = m - 1; i > 0; i--) {
+            uint64_t sub = mul61(coeff[i], tj);
+            uint64_t x = coeff[i - 1];
+            coeff[i] = x >= sub ? x - sub : x + PRIME_A - sub;
+        }
+        uint64_t sub = mul61(coeff[0], tj);
+        coeff[0] = v[j] >= sub ? v[j] - sub : v[j] + PRIME_A - sub;
+    }
+}
+
+int tk_knot_alexander(const tk_curve *c, size_t comp, unsigned long long seed,
+                      long long coeff[TK_ALEXANDER_MAX_DEGREE + 1], int *degree,
+                      size_t *crossings, tk_error *err)
+{
+    crossing *x = NULL;
+    size_t m = 0;
+    int rc = diagram(c, comp, seed, &x, &m, err);
+    if (rc)
+        return rc;
+    if (crossings)
+        *crossings = m;
+    if (m < 2) {
+        free(x);
+        coeff[0] = 1;
+        *degree = 0;
+        return TK_OK;
+    }
+    /* Row i of the Alexander matrix (Fox calculus on the Wirtinger
+     * relation at crossing i, abelianised): (1 - t) in the over-arc's
+     * column; t and -1 in the columns of the arcs ending and starting
+     * there, in that order for a positive crossing and swapped for a
+     * negative one.  Any minor of order m - 1 is +-t^s Delta(t). */
+    size_t k = m - 1;
+    size_t *over = malloc(m * sizeof *over);
+    uint64_t *a = malloc(k * k * sizeof *a);
+    uint64_t *v = malloc(m * sizeof *v);
+    uint64_t *p = malloc(m * sizeof *p);
+    if (!over || !a || !v || !p) {
+        rc = tk_error_set(err, TK_ENOMEM, "out of memory for %zu crossings", m);
+        goto done;
+    }
+    for (size_t i = 0; i < m; i++)
+        over[i] = arc_of(x, m, x[i].over);
+    for (size_t j = 0; j < m; j++) {
+        long long t = (long long)j + 2;
+        for (size_t i = 0; i < k * k; i++)
+            a[i] = 0;
+        for (size_t i = 0; i < k; i++) {
+            size_t in = (i + m - 1) % m, out = i;
+            long long entry[3] = {1 - t, x[i].sign > 0 ? t : -1, x[i].sign > 0 ? -1 : t};
+            size_t column[3] = {over[i], in, out};
+            for (int e = 0; e < 3; e++)
+                if (column[e] < k)
+                    a[i * k + column[e]] = (a[i * k + column[e]] + mod61(entry[e])) % PRIME_A;
+        }
+        v[j] = det61(a, k);
+    }
+    interpolate61(v, m, p);
+    /* +-t^s Delta: strip the power of t, read the coefficients as small
+     * integers, then the sign that makes Delta(1) = 1. */
+    size_t low = 0, high = m - 1;
+    while (low < m && p[low] == 0)
+        low++;
+    if (low == m) {
+        rc = tk_error_set(err, TK_ENUMERIC,
+                          "component %zu: the Alexander matrix of a %zu-crossing projection is "
+                          "singular, which no knot diagram's is",
+                          comp, m);
+        goto done;
+    }
+    while (p[high] == 0)
+        high--;
+    if (high - low > TK_ALEXANDER_MAX_DEGREE) {
+        rc = tk_error_set(err, TK_ELIMIT,
+                          "component %zu: the Alexander polynomial has degree %zu, more than "
+                          "%d",
+                          comp, high - low, TK_ALEXANDER_MAX_DEGREE);
+        goto done;
+    }
+    *degree = (int)(high - low);
+    long long at_one = 0;
+    for (size_t i = low; i <= high; i++) {
+        coeff[i - low] = symmetric(p[i], PRIME_A);
+        at_one += coeff[i - low];
+    }
+    for (int i = 0; i <= *degree; i++) {
+        if (at_one < 0)
+            coeff[i] = -coeff[i];
+        /* a knot's polynomial is symmetric and Delta(1) = +-1: anything
+         * else is a coefficient beyond 2^60 or a broken diagram */
+        if (coeff[i] != (at_one < 0 ? -1 : 1) * symmetric(p[high - (size_t)i], PRIME_A) ||
+            (at_one != 1 && at_one != -1)) {
+            rc = tk_error_set(err, TK_ENUMERIC,
+                              "component %zu: the Alexander polynomial from a %zu-crossing "
+                              "projection is not a knot's (Delta(1) = %lld)",
+                              comp, m, at_one);
+            goto done;
+        }
+    }
+done:
+    free(x);
+    free(over);
+    free(a);
+    free(v);
+    free(p);
+    return rc;
+}
+
+/* ---- the type of a curve ---- */
+
+/* The seed of the projections: any gives the same invariants. */
+#define INVARIANT_SEED 1
+
+void tk_invariants_free(tk_invariants *inv)
+{
+    free(inv->knot);
+    free(inv->linking);
+    *inv = (tk_invariants)TK_INVARIANTS_INIT;
+}
+
+int tk_invariants_compute(const tk_curve *c, tk_invariants *out, tk_error *err)
+{
+    tk_invariants_free(out);
+    size_t n = c->ncomp;
+    out->knot = calloc(n, sizeof *out->knot);
+    out->linking = calloc(n * n, sizeof *out->linking);
+    if (!out->knot || !out->linking) {
+        tk_invariants_free(out);
+        return tk_error_set(err, TK_ENOMEM, "out of memory for the invariants");
+    }
+    out->ncomp = n;
+    out->complete = true;
+    int rc = TK_OK;
+    for (size_t a = 0; a < n && !rc; a++) {
+        tk_knot_type *k = &out->knot[a];
+        if (!c->closed[a])
+            continue;
+        rc = tk_knot_alexander(c, a, INVARIANT_SEED, k->alexander, &k->degree, NULL, err);
+        if (rc == TK_ELIMIT) {
+            out->complete = false;
+            rc = TK_OK;
+            continue;
+        }
+        if (rc)
+            break;
+        k->known = true;
+        long long at_minus_one = 0;
+        for (int i = 0; i <= k->degree; i++)
+            at_minus_one += (i % 2 ? -1 : 1) * k->alexander[i];
+        k->determinant = at_minus_one < 0 ? -at_minus_one : at_minus_one;
+    }
+    for (size_t a = 0; a < n && !rc; a++)
+        for (size_t b = a + 1; b < n && !rc && c->closed[a]; b++) {
+            if (!c->closed[b])
+                continue;
+            long lk = 0;
+            rc = tk_linking_number(c, a, b, &lk, NULL, err);
+            out->linking[a * n + b] = out->linking[b * n + a] = lk;
+        }
+    if (rc)
+        tk_invariants_free(out);
+    return rc;
+}
+
+int tk_invariants_copy(const tk_invariants *src, tk_invariants *out, tk_error *err)
+{
+    tk_invariants_free(out);
+    size_t n = src->ncomp;
+    if (!n)
+        return TK_OK;
+    out->knot = malloc(n * sizeof *out->knot);
+    out->linking = malloc(n * n * sizeof *out->linking);
+    if (!out->knot || !out->linking) {
+        tk_invariants_free(out);
+        return tk_error_set(err, TK_ENOMEM, "out of memory for the invariants");
+    }
+    memcpy(out->knot, src->knot, n * sizeof *out->knot);
+    memcpy(out->linking, src->linking, n * n * sizeof *out->linking);
+    out->ncomp = n;
+    out->complete = src->complete;
+    return TK_OK;
+}
+
+void tk_alexander_format(const tk_knot_type *k, char *buf, size_t size)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (int i = 0; i <= k->degree && used < size; i++) {
+        long long c = k->alexander[i];
+        if (c == 0)
+            continue;
+        long long mag = c < 0 ? -c : c;
+        const char *sign = used == 0 ? (c < 0 ? "-" : "") : (c < 0 ? " - " : " + ");
+        char coefficient[32] = "";
+        if (mag != 1 || i == 0)
+            snprintf(coefficient, sizeof coefficient, "%lld", mag);
+        char power[32] = "";
+        if (i == 1)
+            snprintf(power, sizeof power, "t");
+        else if (i > 1)
+            snprintf(power, sizeof power, "t^%d", i);
+        int w = snprintf(buf + used, size - used, "%s%s%s", sign, coefficient, power);
+        used += w > 0 ? (size_t)w : 0;
+    }
+}
+
+int tk_invariants_compare(const tk_invariants *was, const tk_invariants *now, tk_error *err)
+{
+    if (was->ncomp != now->ncomp)
+        return tk_error_set(err, TK_ETYPE, "the curve had %zu components, now %zu", was->ncomp,
+                            now->ncomp);
+    size_t n = was->ncomp;
+    for (size_t a = 0; a < n; a++) {
+        const tk_knot_type *x = &was->knot[a], *y = &now->knot[a];
+        if (!x->known || !y->known)
+            continue;
+        bool same = x->degree == y->degree;
+        for (int i = 0; same && i <= x->degree; i++)
+            same = x->alexander[i] == y->alexander[i];
+        if (!same) {
+            char before[160], after[160];
+            tk_alexander_format(x, before, sizeof before);
+            tk_alexander_format(y, after, sizeof after);
+            return tk_error_set(err, TK_ETYPE,
+                                "the knot type of component %zu changed: its Alexander polynomial "
+                                "was %s, now %s",
+                                a, before, after);
+        }
+    }
+    for (size_t a = 0; a < n; a++)
+        for (size_t b = a + 1; b < n; b++)
+            if (was->linking[a * n + b] != now->linking[a * n + b])
+                return tk_error_set(err, TK_ETYPE,
+                                    "the link type changed: the linking number of components "
+                                    "%zu and %zu was %ld, now %ld",
+                                    a, b, was->linking[a * n + b], now->linking[a * n + b]);
     return TK_OK;
 }

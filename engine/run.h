@@ -36,6 +36,7 @@
 #include <stddef.h>
 #include <stdlib.h>
 
+#include "tk/invariants.h"
 #include "tk/nnls.h"
 #include "tk/struts.h"
 #include "tk/tighten.h"
@@ -131,6 +132,14 @@ struct tk_run {
         void *user;
         double seconds;  /* spent in tk_run_new and tk_run_step */
     } life;
+
+    struct {             /* tighten.c: the knot or link type */
+        tk_invariants start;   /* of the input, as given */
+        tk_invariants latest;  /* of the run's curve at the last check */
+        long checked_step;     /* the step of the last check, -1 before */
+        size_t checked_vertices;
+        double seconds;
+    } type;
 };
 
 /* Monotonic wall time in seconds, for the timing figures. */
@@ -159,6 +168,13 @@ static inline double tk_norm(const double *v, size_t n)
         s += v[i] * v[i];
     return sqrt(s);
 }
+
+/* ---- tighten.c ---- */
+
+/* The run's curve still has the start's knot or link type; else TK_ETYPE
+ * with a message that begins with `when` ("resampling to 400 vertices").
+ * Skipped when the curve has not moved since the last check. */
+int tk_type_check(tk_run *r, const char *when, tk_error *err);
 
 /* ---- active.c ---- */
 

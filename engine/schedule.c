@@ -1,6 +1,7 @@
 /* The schedule: the polygon a run starts from, the tolerances as the run
  * polishes, coarse to fine and re-resolution.  The only room that changes
  * the vertex count.  See run.h for the rooms of the flow. */
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "run.h"
@@ -214,7 +215,9 @@ static int resample_to(tk_run *r, size_t count, tk_error *err)
     if (worst > 0.0)
         tk_recovery_rescale(r, worst);
     tk_stepping_reset(r);
-    return TK_OK;
+    char when[64];
+    snprintf(when, sizeof when, "resampling to %zu vertices", r->shared.curve->nvert);
+    return tk_type_check(r, when, err);
 }
 
 /* Coarse to fine: a coarse polygon has fewer, longer edges, so each step

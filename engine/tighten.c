@@ -1,6 +1,7 @@
 /* The run's life: creation, the order of a step's rooms, the history and
  * snapshots, the stop criteria.  The rooms and the state they own are
  * described in run.h. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -80,6 +81,8 @@ void tk_run_free(tk_run **p)
     free(r->life.history);
     free(r->life.snapshots);
     free(r->life.snapshot_steps);
+    tk_invariants_free(&r->type.start);
+    tk_invariants_free(&r->type.latest);
     free(r);
     *p = NULL;
 }
@@ -143,9 +146,26 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
     r->min_radius = opts->lambda * opts->radius;
     atomic_init(&r->life.cancel, 0);
     r->life.started = tk_clock();
+    r->type.checked_step = -1;
     rc = tk_nnls_new(&r->shared.nnls, err);
     if (!rc)
         rc = tk_schedule_start(r, start, err);
+    if (!rc) {
+        /* the start as given (tk_schedule_start validated it), before
+         * resampling and scaling */
+        double t0 = tk_clock();
+        rc = tk_invariants_compute(start, &r->type.start, err);
+        r->type.seconds += tk_clock() - t0;
+        if (rc)
+            tk_error_set(err, rc, "the knot or link type of the start cannot be told: %s",
+                         err ? err->message : "");
+    }
+    if (!rc && r->shared.curve->nvert != start->nvert) {
+        char when[64];
+        snprintf(when, sizeof when, "resampling to %zu vertices (resolution %g)",
+                 r->shared.curve->nvert, r->opt.resolution);
+        rc = tk_type_check(r, when, err);
+    }
     tk_step_report rep = {0};
     rep.rcond = 1.0;
     rep.residual = NAN;
@@ -218,6 +238,36 @@ static void check_stop(tk_run *r)
     r->life.stop = stop;
 }
 
+int tk_type_check(tk_run *r, const char *when, tk_error *err)
+{
+    const tk_curve *c = r->shared.curve;
+    if (r->type.checked_step == r->life.latest.step && r->type.checked_vertices == c->nvert)
+        return TK_OK;
+    double t0 = tk_clock();
+    tk_error why;
+    int rc = tk_invariants_compute(c, &r->type.latest, &why);
+    if (!rc)
+        rc = tk_invariants_compare(&r->type.start, &r->type.latest, &why);
+    r->type.seconds += tk_clock() - t0;
+    r->type.checked_step = r->life.latest.step;
+    r->type.checked_vertices = c->nvert;
+    if (rc)
+        return tk_error_set(err, rc == TK_ETYPE ? TK_ETYPE : rc, "%s: %s", when, why.message);
+    return TK_OK;
+}
+
+/* A run that stops (for any reason but a failure) has its result's type
+ * checked against the start's. */
+static int check_result(tk_run *r, tk_error *err)
+{
+    if (r->life.stop == TK_STOP_NONE || r->life.stop == TK_STOP_FAILED)
+        return TK_OK;
+    int rc = tk_type_check(r, "tightening changed the knot or link type", err);
+    if (rc)
+        r->life.stop = TK_STOP_FAILED;
+    return rc;
+}
+
 static int step(tk_run *r, tk_error *err);
 
 int tk_run_step(tk_run *r, tk_error *err)
@@ -271,7 +321,7 @@ static int step(tk_run *r, tk_error *err)
         tk_run_cancel(r);
     r->life.stop = TK_STOP_NONE;
     check_stop(r);
-    return TK_OK;
+    return check_result(r, err);
 }
 
 int tk_run_until(tk_run *r, tk_stop_reason *reason, tk_error *err)
@@ -280,7 +330,10 @@ int tk_run_until(tk_run *r, tk_stop_reason *reason, tk_error *err)
     if (r->life.stop != TK_STOP_FAILED)
         r->life.stop = TK_STOP_NONE;
     check_stop(r);
-    while (r->life.stop == TK_STOP_NONE) {
+    double t0 = tk_clock();
+    rc = check_result(r, err);
+    r->life.seconds += tk_clock() - t0;
+    while (!rc && r->life.stop == TK_STOP_NONE) {
         rc = tk_run_step(r, err);
         if (rc)
             break;
@@ -336,7 +389,18 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out)
         .nnls_solves = r->motion.nnls_solves,
         .nnls_iterations = r->motion.nnls_iterations,
         .factorisations = r->motion.factorisations,
+        .invariants = r->type.seconds,
     };
+}
+
+const tk_invariants *tk_run_type_start(const tk_run *r)
+{
+    return &r->type.start;
+}
+
+const tk_invariants *tk_run_type_latest(const tk_run *r)
+{
+    return r->type.checked_step >= 0 ? &r->type.latest : &r->type.start;
 }
 
 tk_stop_reason tk_run_stop_reason(const tk_run *r)

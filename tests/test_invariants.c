@@ -310,6 +310,186 @@ START_TEST(a_crossing_change_is_caught)
 }
 END_TEST
 
+/* The Alexander polynomial of T(p, q), (t^pq - 1)(t - 1) / ((t^p - 1)
+ * (t^q - 1)), by exact long division: an independent reference. */
+static int torus_alexander(int p, int q, long long *coeff)
+{
+    long long num[64] = {0}, den[64] = {0};
+    /* (t^pq - 1)(t - 1) */
+    num[p * q + 1] += 1;
+    num[p * q] -= 1;
+    num[1] -= 1;
+    num[0] += 1;
+    /* (t^p - 1)(t^q - 1) */
+    den[p + q] += 1;
+    den[p] -= 1;
+    den[q] -= 1;
+    den[0] += 1;
+    int dn = p * q + 1, dd = p + q, dq = dn - dd;
+    for (int i = dq; i >= 0; i--) {
+        coeff[i] = num[i + dd]; /* den is monic */
+        for (int j = 0; j <= dd; j++)
+            num[i + j] -= coeff[i] * den[j];
+    }
+    for (int i = 0; i <= dn; i++)
+        ck_assert_int_eq(num[i], 0); /* it divides */
+    return dq;
+}
+
+static void assert_alexander(const tk_curve *c, size_t comp, const long long *want, int degree,
+                             const char *what)
+{
+    long long got[TK_ALEXANDER_MAX_DEGREE + 1];
+    int deg = -1;
+    tk_error err;
+    for (unsigned long long seed = 1; seed <= 3; seed++) {
+        ck_assert_msg(tk_knot_alexander(c, comp, seed, got, &deg, NULL, &err) == TK_OK, "%s: %s",
+                      what, err.message);
+        ck_assert_msg(deg == degree, "%s seed %llu: degree %d, not %d", what, seed, deg, degree);
+        for (int i = 0; i <= degree; i++)
+            ck_assert_msg(got[i] == want[i], "%s seed %llu: coefficient %d is %lld, not %lld",
+                          what, seed, i, got[i], want[i]);
+    }
+}
+
+START_TEST(torus_knot_alexander_polynomials)
+{
+    const int pq[][2] = {{2, 3}, {2, 5}, {2, 7}, {3, 4}, {3, 5}, {2, 9}, {3, 7}};
+    for (size_t k = 0; k < sizeof pq / sizeof *pq; k++) {
+        long long want[64];
+        int degree = torus_alexander(pq[k][0], pq[k][1], want);
+        tk_curve *c = NULL;
+        ck_assert_int_eq(tk_generate_torus(pq[k][0], pq[k][1], 0, &c, NULL), TK_OK);
+        char what[64];
+        snprintf(what, sizeof what, "T(%d,%d)", pq[k][0], pq[k][1]);
+        assert_alexander(c, 0, want, degree, what);
+        /* the same knot from another start */
+        tk_curve *d = NULL;
+        ck_assert_int_eq(tk_generate_disguise(c, 40 + k, 0.05, &d, NULL), TK_OK);
+        assert_alexander(d, 0, want, degree, what);
+        tk_curve_free(&d);
+        tk_curve_free(&c);
+    }
+    /* the figure-eight: -1 + 3t - t^2, also mirrored */
+    const long long eight[] = {-1, 3, -1};
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_figure_eight(48, &c, NULL), TK_OK);
+    assert_alexander(c, 0, eight, 2, "figure-eight at 48 vertices");
+    for (size_t v = 0; v < c->nvert; v++)
+        tk_curve_vertex(c, v)[2] *= -1.0;
+    assert_alexander(c, 0, eight, 2, "mirrored figure-eight");
+    tk_curve_free(&c);
+    tk_curve *round = tkt_regular_polygon(40, 2.0);
+    const long long one[] = {1};
+    assert_alexander(round, 0, one, 0, "a round polygon");
+    tk_curve_free(&round);
+}
+END_TEST
+
+START_TEST(catalogue_alexander_polynomials)
+{
+    if (!tkt_catalogue_dir()) {
+        printf("catalogue absent: catalogue Alexander polynomials skipped\n");
+        return;
+    }
+    /* Rolfsen's table, normalised to Delta(1) = 1 */
+    const struct {
+        const char *name;
+        int degree;
+        long long coeff[5];
+    } known[] = {{"5.2.vect", 2, {2, -3, 2}},
+                 {"6.1.vect", 2, {-2, 5, -2}},
+                 {"6.2.vect", 4, {-1, 3, -3, 3, -1}},
+                 {"6.3.vect", 4, {1, -3, 5, -3, 1}},
+                 {"7.2.vect", 2, {3, -5, 3}}};
+    for (size_t k = 0; k < sizeof known / sizeof *known; k++) {
+        tk_curve *c = tkt_catalogue_curve(known[k].name);
+        assert_alexander(c, 0, known[k].coeff, known[k].degree, known[k].name);
+        tk_curve_free(&c);
+    }
+    /* Every closed component of the catalogue: |Delta(-1)| is the
+     * determinant found from the colouring matrix (another matrix, another
+     * arithmetic). */
+    size_t count = 0, components = 0;
+    char **names = tkt_catalogue_names(&count);
+    for (size_t i = 0; i < count; i++) {
+        tk_curve *c = tkt_catalogue_curve(names[i]);
+        tk_invariants inv = TK_INVARIANTS_INIT;
+        tk_error err;
+        ck_assert_msg(tk_invariants_compute(c, &inv, &err) == TK_OK, "%s: %s", names[i],
+                      err.message);
+        ck_assert_msg(inv.complete, "%s", names[i]);
+        for (size_t a = 0; a < c->ncomp; a++) {
+            if (!c->closed[a])
+                continue;
+            ck_assert_msg(inv.knot[a].determinant == det_of(c, a, 5), "%s component %zu",
+                          names[i], a);
+            components++;
+        }
+        tk_invariants_free(&inv);
+        tk_curve_free(&c);
+    }
+    tkt_free_names(names, count);
+    ck_assert_uint_ge(components, 398);
+}
+END_TEST
+
+START_TEST(the_type_record)
+{
+    tk_curve *c = NULL;
+    tk_invariants was = TK_INVARIANTS_INIT, now = TK_INVARIANTS_INIT;
+    tk_error err;
+    /* the Borromean rings: unknotted, unlinked pairwise */
+    ck_assert_int_eq(tk_generate_borromean(60, &c, NULL), TK_OK);
+    ck_assert_int_eq(tk_invariants_compute(c, &was, &err), TK_OK);
+    ck_assert_uint_eq(was.ncomp, 3);
+    for (size_t a = 0; a < 3; a++) {
+        ck_assert(was.knot[a].known);
+        ck_assert_int_eq(was.knot[a].degree, 0);
+        ck_assert_int_eq(was.knot[a].determinant, 1);
+        for (size_t b = 0; b < 3; b++)
+            ck_assert_int_eq(was.linking[a * 3 + b], 0);
+    }
+    tk_curve_free(&c);
+    /* the Hopf link, disguised: the same type */
+    ck_assert_int_eq(tk_generate_hopf(40, &c, NULL), TK_OK);
+    ck_assert_int_eq(tk_invariants_compute(c, &was, &err), TK_OK);
+    ck_assert_int_eq(labs(was.linking[1]), 1);
+    ck_assert_int_eq(was.linking[1], was.linking[2]);
+    tk_curve *d = NULL;
+    ck_assert_int_eq(tk_generate_disguise(c, 3, 0.05, &d, NULL), TK_OK);
+    ck_assert_int_eq(tk_invariants_compute(d, &now, &err), TK_OK);
+    ck_assert_int_eq(tk_invariants_compare(&was, &now, &err), TK_OK);
+    /* one ring reversed: the linking number changes sign, and is caught */
+    size_t n = tk_curve_comp_vertices(d, 1);
+    double *x = d->xyz + 3 * d->offset[1];
+    for (size_t i = 0, j = n - 1; i < j; i++, j--)
+        for (int k = 0; k < 3; k++) {
+            double t = x[3 * i + k];
+            x[3 * i + k] = x[3 * j + k];
+            x[3 * j + k] = t;
+        }
+    ck_assert_int_eq(tk_invariants_compute(d, &now, &err), TK_OK);
+    ck_assert_int_eq(tk_invariants_compare(&was, &now, &err), TK_ETYPE);
+    ck_assert_msg(strstr(err.message, "linking number of components 0 and 1 was") != NULL, "%s",
+                  err.message);
+    tk_curve_free(&d);
+    tk_curve_free(&c);
+    /* the trefoil against the unknot */
+    ck_assert_int_eq(tk_generate_torus(2, 3, 0, &c, NULL), TK_OK);
+    ck_assert_int_eq(tk_invariants_compute(c, &was, &err), TK_OK);
+    tk_curve *round = tkt_regular_polygon(40, 2.0);
+    ck_assert_int_eq(tk_invariants_compute(round, &now, &err), TK_OK);
+    ck_assert_int_eq(tk_invariants_compare(&was, &now, &err), TK_ETYPE);
+    ck_assert_str_eq(err.message, "the knot type of component 0 changed: its Alexander "
+                                  "polynomial was 1 - t + t^2, now 1");
+    tk_curve_free(&round);
+    tk_curve_free(&c);
+    tk_invariants_free(&was);
+    tk_invariants_free(&now);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("invariants");
@@ -326,6 +506,9 @@ int main(void)
     tcase_add_test(knots, torus_knot_determinants);
     tcase_add_test(knots, catalogue_knot_determinants);
     tcase_add_test(knots, a_crossing_change_is_caught);
+    tcase_add_test(knots, torus_knot_alexander_polynomials);
+    tcase_add_test(knots, catalogue_alexander_polynomials);
+    tcase_add_test(knots, the_type_record);
     suite_add_tcase(s, knots);
     return tkt_run_suite(s);
 }

@@ -655,7 +655,8 @@ START_TEST(timing_accounts_for_the_run)
            "iterations, %ld factorisations), checks %.4f, stepping %.4f, recovery %.4f\n",
            t.total, wall, t.search, t.matrix, t.nnls, t.nnls_solves, t.nnls_iterations,
            t.factorisations, t.checks, t.stepping, t.recovery);
-    double parts[] = {t.search, t.matrix, t.nnls, t.checks, t.stepping, t.recovery};
+    printf("timing: the knot type (start and result) %.4f s\n", t.invariants);
+    double parts[] = {t.search, t.matrix, t.nnls, t.checks, t.stepping, t.recovery, t.invariants};
     for (size_t k = 0; k < sizeof parts / sizeof parts[0]; k++)
         ck_assert(parts[k] > 0.0 && parts[k] <= t.total);
     ck_assert(t.search + t.matrix + t.nnls + t.checks <= t.total);
@@ -674,6 +675,48 @@ START_TEST(timing_accounts_for_the_run)
 }
 END_TEST
 
+/* The type is checked where the flow's constraints do not hold it: a
+ * trefoil resampled to 4 vertices is an unknot, and the run is refused
+ * with the reason; a run that keeps its type reports it, start and
+ * result. */
+START_TEST(the_knot_type_is_checked)
+{
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 120, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 0.1;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_ETYPE);
+    ck_assert_ptr_null(run);
+    ck_assert_msg(strstr(err.message, "resampling to 4 vertices") != NULL &&
+                      strstr(err.message, "Alexander polynomial was 1 - t + t^2, now 1") != NULL,
+                  "%s", err.message);
+    tk_curve_free(&c);
+
+    ck_assert_int_eq(tk_generate_chain(3, 40, &c, NULL), TK_OK);
+    o.resolution = 0.0;
+    o.max_steps = 30;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    const tk_invariants *start = tk_run_type_start(run);
+    ck_assert_ptr_eq(tk_run_type_latest(run), start); /* nothing checked yet */
+    ck_assert_int_eq(tk_run_until(run, NULL, &err), TK_OK);
+    const tk_invariants *result = tk_run_type_latest(run);
+    ck_assert_ptr_ne(result, start);
+    ck_assert(result->complete && start->complete);
+    ck_assert_int_eq(tk_invariants_compare(start, result, &err), TK_OK);
+    /* neighbours link once, the ends not at all */
+    ck_assert_int_eq(labs(result->linking[0 * 3 + 1]), 1);
+    ck_assert_int_eq(labs(result->linking[1 * 3 + 2]), 1);
+    ck_assert_int_eq(result->linking[0 * 3 + 2], 0);
+    for (size_t k = 0; k < 3; k++)
+        ck_assert_int_eq(result->knot[k].determinant, 1);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("tighten");
@@ -683,6 +726,7 @@ int main(void)
     tcase_add_test(tc, corrected_steps_report_their_forces);
     tcase_add_test(tc, history_and_snapshots);
     tcase_add_test(tc, timing_accounts_for_the_run);
+    tcase_add_test(tc, the_knot_type_is_checked);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
     tcase_add_test(tc, cancellation_stops_within_one_step);

@@ -2,7 +2,8 @@
  *
  *   tightknot info [--json] [--tolerance EPS] FILE...
  *   tightknot struts [--json] [--tolerance EPS] FILE
- *   tightknot generate torus P Q | hopf | borromean | chain K [--vertices N]
+ *   tightknot generate torus P Q | figure-eight | hopf | borromean | chain K
+ *                      [--vertices N] [--disguise SEED]
  *   tightknot tighten FILE [run options] [-o OUT] [--struts OUT] [--log OUT]
  *                    [--snapshots DIR --every K] [--json]
  *   tightknot remote [--server URL] submit|status|cancel|fetch ...
@@ -136,7 +137,7 @@ static const char struts_help[] =
     "  tightknot struts --tolerance 1e-3 ../shared/catalogue/3_1_328.vect\n";
 
 static const char generate_help[] =
-    "usage: tightknot generate SHAPE [--vertices N]\n"
+    "usage: tightknot generate SHAPE [--vertices N] [--disguise SEED]\n"
     "\n"
     "Writes an example knot or link as VECT (full precision) on standard\n"
     "output.  Every component is a closed polygon with vertices evenly\n"
@@ -145,6 +146,8 @@ static const char generate_help[] =
     "  torus P Q   the torus knot or link T(P, Q), P, Q >= 1, on the torus of\n"
     "              radii 2 and 1; gcd(P, Q) components (T(2,3) is the\n"
     "              trefoil, T(2,4) a two-component link)\n"
+    "  figure-eight  the figure-eight knot ((2 + cos 2t) cos 3t,\n"
+    "              (2 + cos 2t) sin 3t, sin 4t)\n"
     "  hopf        the Hopf link: two circles of radius 1 in perpendicular\n"
     "              planes, each through the other's centre (tight at\n"
     "              thickness 1: ropelength 8 pi); N is rounded up to even\n"
@@ -157,6 +160,11 @@ static const char generate_help[] =
     "  --vertices N   vertices per component (default: torus about 40 per\n"
     "                 turn, at least 60; hopf 64; borromean 96; chain 64).\n"
     "                 Too few to keep the polygon embedded is refused.\n"
+    "  --disguise SEED   the same knot or link as another start would give\n"
+    "                 it: vertices moved along each component to uneven\n"
+    "                 spacing, displaced at random by 5% of the mean edge,\n"
+    "                 and the whole turned by a random rotation, all drawn\n"
+    "                 from SEED (an integer; the same seed, the same curve)\n"
     "  -h, --help     show this help\n"
     "\n"
     "Conventions (as in 'tightknot info'): thickness is the tube diameter,\n"
@@ -167,7 +175,8 @@ static const char generate_help[] =
     "of range), 2 failure writing the output.\n"
     "\n"
     "Example:\n"
-    "  tightknot generate torus 2 3 --vertices 150 > trefoil.vect\n";
+    "  tightknot generate torus 2 3 --vertices 150 > trefoil.vect\n"
+    "  tightknot generate figure-eight --disguise 7 > figure-eight.vect\n";
 
 static const char tighten_help[] =
     "usage: tightknot tighten FILE [OPTIONS]\n"
@@ -245,7 +254,8 @@ enum {
     OPT_EVERY = 1u << 14,
     OPT_OVERSTEP = 1u << 15,
     OPT_RERESOLVE = 1u << 16,
-    OPT_NO_COARSE = 1u << 17
+    OPT_NO_COARSE = 1u << 17,
+    OPT_DISGUISE = 1u << 18
 };
 #define TIGHTEN_OPTIONS                                                                   \
     (OPT_JSON | OPT_RADIUS | OPT_LAMBDA | OPT_RESOLUTION | OPT_AUTOSCALE | OPT_STEPS |     \
@@ -277,6 +287,7 @@ static const option_spec option_specs[] = {
     {"overstep", OPT_OVERSTEP, true},
     {"re-resolve", OPT_RERESOLVE, true},
     {"no-coarse", OPT_NO_COARSE, false},
+    {"disguise", OPT_DISGUISE, true},
 };
 
 typedef struct cli_args {
@@ -284,6 +295,8 @@ typedef struct cli_args {
     bool json;
     double tolerance;
     size_t vertices; /* 0: the generator's default */
+    bool disguise;   /* generate: tk_generate_disguise with this seed */
+    unsigned long long seed;
     tk_job_options job; /* tighten's run options */
     double overstep;    /* 0: the engine's default */
     double re_resolve;  /* tk_options.re_resolve */
@@ -423,6 +436,14 @@ static int apply_option(const char *cmd, unsigned flag, const char *value, cli_a
         a->every = (size_t)n;
         return EXIT_OK;
     }
+    case OPT_DISGUISE: {
+        long long n = 0;
+        if (parse_integer(cmd, "--disguise", value, 0, LLONG_MAX, &n))
+            return EXIT_USAGE;
+        a->disguise = true;
+        a->seed = (unsigned long long)n;
+        return EXIT_OK;
+    }
     case OPT_OUTPUT:
         a->output = value;
         return EXIT_OK;
@@ -451,6 +472,8 @@ static int parse_args(const char *cmd, int argc, char **argv, unsigned allowed,
     a->json = false;
     a->tolerance = DEFAULT_TOLERANCE;
     a->vertices = 0;
+    a->disguise = false;
+    a->seed = 0;
     tk_job_options defaults = TK_JOB_OPTIONS_INIT;
     a->job = defaults;
     a->overstep = 0.0;
@@ -729,7 +752,8 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
 {
     const char *cmd = "generate";
     if (npos == 0)
-        return usage_error(cmd, "no SHAPE given (torus P Q, hopf, borromean or chain K)");
+        return usage_error(cmd, "no SHAPE given (torus P Q, figure-eight, hopf, borromean or "
+                                "chain K)");
     const char *shape = pos[0];
     tk_error err;
     tk_error_clear(&err);
@@ -742,11 +766,13 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
             parse_integer(cmd, "torus Q", pos[2], INT_MIN, INT_MAX, &q))
             return EXIT_USAGE;
         rc = tk_generate_torus((int)p, (int)q, vertices, out, &err);
-    } else if (strcmp(shape, "hopf") == 0 || strcmp(shape, "borromean") == 0) {
+    } else if (strcmp(shape, "hopf") == 0 || strcmp(shape, "borromean") == 0 ||
+               strcmp(shape, "figure-eight") == 0) {
         if (npos != 1)
             return usage_error(cmd, "%s takes no arguments", shape);
-        rc = shape[0] == 'h' ? tk_generate_hopf(vertices, out, &err)
-                             : tk_generate_borromean(vertices, out, &err);
+        rc = shape[0] == 'h'   ? tk_generate_hopf(vertices, out, &err)
+             : shape[0] == 'b' ? tk_generate_borromean(vertices, out, &err)
+                               : tk_generate_figure_eight(vertices, out, &err);
     } else if (strcmp(shape, "chain") == 0) {
         if (npos != 2)
             return usage_error(cmd, "chain takes one argument, K");
@@ -755,7 +781,9 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
             return EXIT_USAGE;
         rc = tk_generate_chain((size_t)k, vertices, out, &err);
     } else {
-        return usage_error(cmd, "unknown shape '%s' (torus P Q, hopf, borromean or chain K)",
+        return usage_error(cmd,
+                           "unknown shape '%s' (torus P Q, figure-eight, hopf, borromean or "
+                           "chain K)",
                            shape);
     }
     if (rc == TK_EINVAL || rc == TK_ELIMIT)
@@ -770,7 +798,7 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
 static int cmd_generate(int argc, char **argv)
 {
     cli_args a;
-    if (parse_args("generate", argc, argv, OPT_VERTICES, &a))
+    if (parse_args("generate", argc, argv, OPT_VERTICES | OPT_DISGUISE, &a))
         return EXIT_USAGE;
     if (a.help) {
         fputs(generate_help, stdout);
@@ -782,6 +810,16 @@ static int cmd_generate(int argc, char **argv)
         return status;
     tk_error err;
     tk_error_clear(&err);
+    if (a.disguise) {
+        tk_curve *plain = c;
+        c = NULL;
+        int rc = tk_generate_disguise(plain, a.seed, 0.05, &c, &err);
+        tk_curve_free(&plain);
+        if (rc) {
+            report(NULL, &err);
+            return EXIT_INPUT;
+        }
+    }
     if (tk_vect_write(c, stdout, &err) != TK_OK) {
         report(NULL, &err);
         status = EXIT_INPUT;

@@ -19,7 +19,9 @@ enum tk_status {
     TK_ECANCELLED = 6,
     TK_ELIMIT = 7,   /* input exceeds a configured limit */
     TK_ENOTFOUND = 8,/* no such item (a job id, a catalogue name) */
-    TK_EBUSY = 9     /* a queue or pool is full; try again later */
+    TK_EBUSY = 9,    /* a queue or pool is full; try again later */
+    TK_ETYPE = 10    /* the knot or link type changed (a strand passed
+                        through another) */
 };
 
 #define TK_ERROR_MESSAGE_SIZE 320

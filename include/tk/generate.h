@@ -31,4 +31,22 @@ int tk_generate_borromean(size_t vertices, tk_curve **out, tk_error *err);
 int tk_generate_chain(size_t k, size_t vertices, tk_curve **out,
                       tk_error *err);
 
+/* The figure-eight knot as the closed curve
+ *     ((2 + cos 2t) cos 3t, (2 + cos 2t) sin 3t, sin 4t), t in [0, 2 pi)
+ * (a start that is far from tight and, unlike the catalogue's, symmetric). */
+int tk_generate_figure_eight(size_t vertices, tk_curve **out, tk_error *err);
+
+/* The same knot or link, disguised: each component's vertices moved along
+ * it to uneven spacing (arclength s -> s + 0.3 L sin(2 pi s / L + phase)
+ * / (2 pi), spacing ratio up to 1.86), each vertex displaced by a normal
+ * random vector of standard deviation `perturbation` times the mean edge
+ * length per coordinate, then the whole turned by a uniformly random
+ * rotation.  Everything is drawn from `seed`: the same seed gives the same
+ * curve on every machine.  The knot type survives when the perturbation is
+ * small against the gaps between strands (the caller's to choose; check
+ * with tk/invariants.h).  Vertex counts, closedness and colours are kept;
+ * open components keep their end points in place before the rotation. */
+int tk_generate_disguise(const tk_curve *src, unsigned long long seed, double perturbation,
+                         tk_curve **out, tk_error *err);
+
 #endif

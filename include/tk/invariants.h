@@ -16,6 +16,7 @@
 #ifndef TK_INVARIANTS_H
 #define TK_INVARIANTS_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "tk/curve.h"
@@ -36,7 +37,67 @@ int tk_linking_number(const tk_curve *c, size_t a, size_t b, long *lk, double *g
  * count.  Fails with TK_EINVAL for an open component, TK_ENUMERIC when no
  * generic projection is found or the determinant exceeds 2^60, TK_ENOMEM.
  * O(n^2) for the crossings, O(m^3) in the m crossings. */
+/* Projections with more crossings than this are refused (TK_ELIMIT):
+ * the invariants cost up to O(crossings^3) (the determinant) and
+ * O(crossings^4) (the Alexander polynomial; the matrices are sparse, so
+ * far less: 0.17 s for the 261 crossings of the catalogue's random
+ * 600-gon blob.vect).  The simplest of three generic projections is used;
+ * a tight knot of up to 13 crossings shows a few dozen. */
+#define TK_INVARIANT_MAX_CROSSINGS 400
+/* Highest degree of an Alexander polynomial kept (twice the genus: 12 for
+ * T(3, 7)). */
+#define TK_ALEXANDER_MAX_DEGREE 40
+
 int tk_knot_determinant(const tk_curve *c, size_t comp, unsigned long long seed, long long *det,
                         size_t *crossings, tk_error *err);
+
+/* The Alexander polynomial of closed component comp seen as a knot:
+ * coeff[0..*degree] are its coefficients of 1, t, ..., t^degree,
+ * normalised so that coeff[0] != 0 and Delta(1) = 1 (the trefoil's is
+ * 1 - t + t^2, the figure-eight's -1 + 3t - t^2, the unknot's 1).  From
+ * the Alexander matrix of a projection (seeded as for the determinant)
+ * evaluated at crossings-many points modulo 2^61 - 1 and interpolated;
+ * the result is checked to be symmetric with Delta(1) = +-1.  Fails as
+ * tk_knot_determinant does, and with TK_ELIMIT beyond
+ * TK_ALEXANDER_MAX_DEGREE. */
+int tk_knot_alexander(const tk_curve *c, size_t comp, unsigned long long seed,
+                      long long coeff[TK_ALEXANDER_MAX_DEGREE + 1], int *degree,
+                      size_t *crossings, tk_error *err);
+
+/* ---- the knot or link type of a curve, as a record ---- */
+
+typedef struct tk_knot_type {
+    bool known;        /* false for an open component, or one whose simplest
+                          projection has too many crossings (TK_ELIMIT) */
+    int degree;        /* of the Alexander polynomial */
+    long long alexander[TK_ALEXANDER_MAX_DEGREE + 1];
+    long long determinant; /* |Delta(-1)| */
+} tk_knot_type;
+
+typedef struct tk_invariants {
+    size_t ncomp;
+    tk_knot_type *knot;  /* per component */
+    long *linking;       /* ncomp x ncomp, row major, symmetric; 0 on the
+                            diagonal and for open components */
+    bool complete;       /* every closed component's knot type is known */
+} tk_invariants;
+
+#define TK_INVARIANTS_INIT {0, NULL, NULL, false}
+
+/* The invariants of c into *out (freed first).  Fails with TK_ENUMERIC
+ * when strands (nearly) meet, TK_ENOMEM; a component with too many
+ * crossings is left unknown (out->complete false), not an error. */
+int tk_invariants_compute(const tk_curve *c, tk_invariants *out, tk_error *err);
+void tk_invariants_free(tk_invariants *inv);
+int tk_invariants_copy(const tk_invariants *src, tk_invariants *out, tk_error *err);
+
+/* TK_OK when `now` has the type `was` had (what either leaves unknown is
+ * not compared), else TK_ETYPE with a message naming the first
+ * difference ("component 0: the Alexander polynomial was 1 - t + t^2, now
+ * 1"). */
+int tk_invariants_compare(const tk_invariants *was, const tk_invariants *now, tk_error *err);
+
+/* The polynomial as text, "1 - t + t^2", into buf (always terminated). */
+void tk_alexander_format(const tk_knot_type *k, char *buf, size_t size);
 
 #endif

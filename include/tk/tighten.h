@@ -20,6 +20,11 @@
  *   5. error recovery: while some constraint is violated beyond the
  *      correction tolerance, Newton steps with the minimum-norm solution of
  *      A^T du = -R (section 4.6); rescaling only if that fails.
+ * The flow keeps the tube embedded, so it cannot change the knot or link
+ * type; resampling and recovery move the curve in ways its constraints
+ * do not cover, so the type (tk/invariants.h) of the start is compared
+ * with the run's curve after every resampling and whenever the run stops,
+ * and a difference fails the run (TK_ETYPE).
  * With a resolution the run goes coarse to fine (coarse_to_fine): fewer
  * vertices first, doubled whenever the ropelength all but stops falling.
  * Open components keep their end points fixed.
@@ -35,6 +40,7 @@
 
 #include "tk/curve.h"
 #include "tk/error.h"
+#include "tk/invariants.h"
 #include "tk/struts.h"
 
 typedef struct tk_options {
@@ -150,6 +156,12 @@ const tk_strut *tk_run_struts(const tk_run *r, size_t *count);
 const tk_kink *tk_run_kinks(const tk_run *r, size_t *count);
 tk_stop_reason tk_run_stop_reason(const tk_run *r);
 
+/* The knot or link type of the start as given, and of the run's curve at
+ * the last check (after every resampling and at every stop; the start's
+ * before any).  A run whose type changed has failed (TK_ETYPE). */
+const tk_invariants *tk_run_type_start(const tk_run *r);
+const tk_invariants *tk_run_type_latest(const tk_run *r);
+
 /* Where a run's wall time went, in seconds.  The first four are the
  * operations every step repeats, wherever in the flow they happen;
  * `total` is all of tk_run_new and tk_run_step (the rest of it is the
@@ -167,6 +179,8 @@ typedef struct tk_run_timing {
     double stepping;     /* step control (section 4.5), everything it called */
     double recovery;     /* error recovery (section 4.6), everything it called */
     long nnls_solves, nnls_iterations, factorisations;
+    double invariants;   /* the knot type computed and compared (included
+                            in total) */
 } tk_run_timing;
 
 void tk_run_timing_get(const tk_run *r, tk_run_timing *out);
