@@ -154,6 +154,38 @@ json_t *tk_json_contacts(const tk_curve *c, const tk_strut *struts, size_t nstru
     return o;
 }
 
+json_t *tk_json_invariants(const tk_invariants *inv)
+{
+    if (!inv || inv->ncomp == 0)
+        return json_null();
+    size_t n = inv->ncomp;
+    json_t *alexander = json_array(), *text = json_array(), *det = json_array(),
+           *linking = json_array();
+    for (size_t a = 0; a < n; a++) {
+        const tk_knot_type *k = &inv->knot[a];
+        json_t *coeff = json_null(), *poly = json_null();
+        if (k->known) {
+            coeff = json_array();
+            for (int i = 0; i <= k->degree; i++)
+                json_array_append_new(coeff, json_integer((json_int_t)k->alexander[i]));
+            /* up to 41 terms of "- C t^40" */
+            char buf[1024];
+            tk_alexander_format(k, buf, sizeof buf);
+            poly = json_string(buf);
+        }
+        json_array_append_new(alexander, coeff);
+        json_array_append_new(text, poly);
+        json_array_append_new(det, k->known ? json_integer((json_int_t)k->determinant)
+                                            : json_null());
+        json_t *row = json_array();
+        for (size_t b = 0; b < n; b++)
+            json_array_append_new(row, json_integer((json_int_t)inv->linking[a * n + b]));
+        json_array_append_new(linking, row);
+    }
+    return json_pack("{s:o, s:o, s:o, s:o, s:b}", "alexander", alexander, "alexander_text",
+                     text, "determinants", det, "linking", linking, "complete", inv->complete);
+}
+
 char *tk_json_dump(const json_t *value, bool indent)
 {
     size_t flags = JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17) |

@@ -1,13 +1,16 @@
 /* Tests for the JSON forms of results (server/jsonmap.c): a strut's
  * arclength coordinates, walked along the polygon, land on its points;
  * components are laid end to end; numbers keep every bit; non-finite
- * numbers become null. */
+ * numbers become null; the invariants of the trefoil, the figure-eight
+ * and the Hopf link read back as their known polynomials, determinants
+ * and linking numbers, an unknown component as nulls. */
 #include <check.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "support.h"
+#include "tk/generate.h"
 #include "tk/jsonmap.h"
 #include "tk/thickness.h"
 
@@ -123,6 +126,109 @@ START_TEST(numbers_keep_every_bit_and_infinities_are_null)
 }
 END_TEST
 
+/* The invariants of a generated curve as JSON text, parsed back: what a
+ * client sees. */
+static json_t *invariants_read_back(tk_curve *c)
+{
+    tk_invariants inv = TK_INVARIANTS_INIT;
+    tk_error err;
+    ck_assert_int_eq(tk_invariants_compute(c, &inv, &err), TK_OK);
+    json_t *doc = tk_json_invariants(&inv);
+    char *text = tk_json_dump(doc, false);
+    ck_assert_ptr_nonnull(text);
+    json_t *back = json_loads(text, 0, NULL);
+    ck_assert_ptr_nonnull(back);
+    free(text);
+    json_decref(doc);
+    tk_invariants_free(&inv);
+    tk_curve_free(&c);
+    return back;
+}
+
+static void assert_integers(const json_t *a, const long long *want, size_t n)
+{
+    ck_assert_msg(json_is_array(a) && json_array_size(a) == n, "an array of %zu", n);
+    for (size_t i = 0; i < n; i++) {
+        ck_assert(json_is_integer(json_array_get(a, i)));
+        ck_assert_int_eq(json_integer_value(json_array_get(a, i)), want[i]);
+    }
+}
+
+START_TEST(invariants_of_known_knots_and_links)
+{
+    tk_error err;
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 0, &c, &err), TK_OK);
+    json_t *j = invariants_read_back(c);
+    static const long long trefoil[] = {1, -1, 1}, three[] = {3}, zero[] = {0};
+    ck_assert_uint_eq(json_array_size(json_object_get(j, "alexander")), 1);
+    assert_integers(json_array_get(json_object_get(j, "alexander"), 0), trefoil, 3);
+    ck_assert_str_eq(json_string_value(json_array_get(json_object_get(j, "alexander_text"), 0)),
+                     "1 - t + t^2");
+    assert_integers(json_object_get(j, "determinants"), three, 1);
+    ck_assert_uint_eq(json_array_size(json_object_get(j, "linking")), 1);
+    assert_integers(json_array_get(json_object_get(j, "linking"), 0), zero, 1);
+    ck_assert(json_is_true(json_object_get(j, "complete")));
+    json_decref(j);
+
+    tk_curve *plain = NULL;
+    ck_assert_int_eq(tk_generate_figure_eight(0, &plain, &err), TK_OK);
+    ck_assert_int_eq(tk_generate_disguise(plain, 3, 0.05, &c, &err), TK_OK);
+    tk_curve_free(&plain);
+    j = invariants_read_back(c);
+    static const long long fig8[] = {-1, 3, -1}, five[] = {5};
+    assert_integers(json_array_get(json_object_get(j, "alexander"), 0), fig8, 3);
+    ck_assert_str_eq(json_string_value(json_array_get(json_object_get(j, "alexander_text"), 0)),
+                     "-1 + 3t - t^2");
+    assert_integers(json_object_get(j, "determinants"), five, 1);
+    json_decref(j);
+
+    ck_assert_int_eq(tk_generate_hopf(0, &c, &err), TK_OK);
+    j = invariants_read_back(c);
+    static const long long unknot[] = {1}, ones[] = {1, 1};
+    json_t *lk = json_object_get(j, "linking");
+    ck_assert_uint_eq(json_array_size(lk), 2);
+    long long off = json_integer_value(json_array_get(json_array_get(lk, 0), 1));
+    ck_assert(off == 1 || off == -1);
+    const long long row0[] = {0, off}, row1[] = {off, 0};
+    assert_integers(json_array_get(lk, 0), row0, 2);
+    assert_integers(json_array_get(lk, 1), row1, 2);
+    for (size_t k = 0; k < 2; k++) {
+        assert_integers(json_array_get(json_object_get(j, "alexander"), k), unknot, 1);
+        ck_assert_str_eq(json_string_value(json_array_get(json_object_get(j, "alexander_text"), k)),
+                         "1");
+    }
+    assert_integers(json_object_get(j, "determinants"), ones, 2);
+    json_decref(j);
+}
+END_TEST
+
+START_TEST(unknown_components_are_null)
+{
+    /* a record as the engine leaves it for an open component next to a
+     * trefoil: the open one unknown, the record incomplete */
+    tk_knot_type knots[2] = {{false, 0, {0}, 0}, {true, 2, {1, -1, 1}, 3}};
+    long linking[4] = {0, 0, 0, 0};
+    tk_invariants inv = {2, knots, linking, false};
+    json_t *j = tk_json_invariants(&inv);
+    ck_assert(json_is_null(json_array_get(json_object_get(j, "alexander"), 0)));
+    ck_assert(json_is_null(json_array_get(json_object_get(j, "alexander_text"), 0)));
+    ck_assert(json_is_null(json_array_get(json_object_get(j, "determinants"), 0)));
+    ck_assert_int_eq(json_integer_value(json_array_get(json_object_get(j, "determinants"), 1)), 3);
+    ck_assert(json_is_false(json_object_get(j, "complete")));
+    ck_assert_uint_eq(json_array_size(json_array_get(json_object_get(j, "linking"), 1)), 2);
+    json_decref(j);
+    /* nothing computed: null, not an empty record */
+    tk_invariants none = TK_INVARIANTS_INIT;
+    j = tk_json_invariants(&none);
+    ck_assert(json_is_null(j));
+    json_decref(j);
+    j = tk_json_invariants(NULL);
+    ck_assert(json_is_null(j));
+    json_decref(j);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("jsonmap");
@@ -130,6 +236,8 @@ int main(void)
     tcase_add_test(tc, strut_arclengths_land_on_their_points);
     tcase_add_test(tc, kinks_sit_at_their_vertices);
     tcase_add_test(tc, numbers_keep_every_bit_and_infinities_are_null);
+    tcase_add_test(tc, invariants_of_known_knots_and_links);
+    tcase_add_test(tc, unknown_components_are_null);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);
 }
