@@ -183,7 +183,7 @@ fi
 # ---------------------------------------------------------- round trips
 
 expect_status 0 "info --json on hopf" "$tk" info --json "$tmp/hopf.vect"
-for name in file components vertices length thickness minrad ropelength struts kinks; do
+for name in file components vertices length thickness minrad ropelength struts kinks invariants; do
     expect_match "\"$name\":" "$tmp/out" "info --json has $name"
 done
 expect_value components 2 "$tmp/out" "hopf"
@@ -224,6 +224,24 @@ expect_value vertices 192 "$tmp/out" "chain 3"
 "$tk" generate borromean >"$tmp/borromean.vect"
 expect_status 0 "borromean parses" "$tk" info --json "$tmp/borromean.vect"
 expect_value components 3 "$tmp/out" "borromean"
+
+# The knot or link type: the trefoil's Alexander polynomial 1 - t + t^2
+# and determinant 3; the figure-eight's -1 + 3t - t^2 from a disguised
+# start; the Hopf link's linking number +-1, the same both ways.
+expect_status 0 "info --json on the trefoil" "$tk" info --json "$tmp/trefoil.vect"
+expect_match '"invariants":\{"alexander":\[\[1,-1,1\]\],"alexander_text":\["1 - t \+ t\^2"\],"determinants":\[3\],"linking":\[\[0\]\],"complete":true\}' \
+    "$tmp/out" "info --json: the trefoil's type"
+expect_status 0 "info (text) on the trefoil" "$tk" info "$tmp/trefoil.vect"
+expect_match 'trefoil\.vect +1 +[0-9]+ .* det 3, 1 - t \+ t\^2$' "$tmp/out" "info: the trefoil's type column"
+"$tk" generate figure-eight --disguise 3 >"$tmp/fig8.vect"
+expect_status 0 "info on a disguised figure-eight" "$tk" info --json "$tmp/fig8.vect"
+expect_match '"alexander":\[\[-1,3,-1\]\],"alexander_text":\["-1 \+ 3t - t\^2"\],"determinants":\[5\]' \
+    "$tmp/out" "info --json: the figure-eight's type"
+expect_status 0 "info --json on hopf" "$tk" info --json "$tmp/hopf.vect"
+expect_match '"determinants":\[1,1\],"linking":(\[\[0,1\],\[1,0\]\]|\[\[0,-1\],\[-1,0\]\]),"complete":true' \
+    "$tmp/out" "info --json: the Hopf link's linking number"
+expect_status 0 "info (text) on hopf" "$tk" info "$tmp/hopf.vect"
+expect_match ' det 1 1, lk 0-1: -?1$' "$tmp/out" "info: the Hopf link's type column"
 
 # Standard input as "-", through a pipe.
 "$tk" generate chain 4 | "$tk" info --json - >"$tmp/out" 2>"$tmp/err"

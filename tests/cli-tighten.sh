@@ -81,6 +81,25 @@ check $? "re-resolution: $last vertices for ropelength $rr_rope at resolution 5"
 close "$(value ropelength "$tmp/rr-info.json")" "$rr_rope" 1e-12
 check $? "re-resolved output measured again: $(value ropelength "$tmp/rr-info.json") vs $rr_rope"
 
+# the knot type: the input's and the result's, both the trefoil's
+"$tk" generate torus 2 3 >"$tmp/t23.vect"
+"$tk" tighten "$tmp/t23.vect" --json --steps 20 >"$tmp/type.json" 2>"$tmp/err"
+check $? "tighten --json --steps 20 exits 0: $(cat "$tmp/err")"
+type_start=$(sed -n 's/.*"invariants":{"start":{\([^}]*\)},"result":{\([^}]*\)}}.*/\1/p' "$tmp/type.json")
+type_result=$(sed -n 's/.*"invariants":{"start":{\([^}]*\)},"result":{\([^}]*\)}}.*/\2/p' "$tmp/type.json")
+for part in start result; do
+    eval "t=\$type_$part"
+    case $t in *'"alexander":[[1,-1,1]],"alexander_text":["1 - t + t^2"],"determinants":[3],'*) true ;; *) false ;; esac
+    check $? "tighten --json: the $part's type is the trefoil's: '$t'"
+done
+# resampled to ceil(0.1 * ropelength) = 4 vertices the trefoil is an
+# unknot: the run fails, exit 2, with the engine's message as it is
+"$tk" tighten "$tmp/t23.vect" --resolution 0.1 --autoscale --json >"$tmp/out" 2>"$tmp/err"
+status=$?
+[ "$status" -eq 2 ] && [ "$(wc -l <"$tmp/err")" -eq 1 ] &&
+    grep -q "^tightknot: $tmp/t23.vect: resampling to 4 vertices (resolution 0.1): .*Alexander polynomial was 1 - t + t^2, now 1\$" "$tmp/err"
+check $? "a run that changes the type: exit $status, $(cat "$tmp/err")"
+
 # bad options: exit 1, named
 for args in "--radius 0" "--lambda -1" "--steps 2.5" "--resolution -1" "--time abc" \
     "--residual nan" "--overstep 0.5" "--every 0" "--re-resolve 1" "--re-resolve 0.1" \

@@ -30,6 +30,7 @@
 #include "tk/curve.h"
 #include "tk/error.h"
 #include "tk/generate.h"
+#include "tk/invariants.h"
 #include "tk/jobspec.h"
 #include "tk/jsonmap.h"
 #include "tk/struts.h"
@@ -54,7 +55,8 @@ static const char main_help[] =
     "Measures and makes polygonal knots and links in Geomview VECT format.\n"
     "\n"
     "Commands:\n"
-    "  info       length, thickness, ropelength and contacts of VECT files\n"
+    "  info       length, thickness, ropelength, contacts and knot or link type\n"
+    "             of VECT files\n"
     "  struts     the struts (self-contacts) and kinks of one VECT file\n"
     "  generate   write an example knot or link (torus, Hopf, Borromean,\n"
     "             chain) as VECT on standard output\n"
@@ -78,9 +80,9 @@ static const char info_help[] =
     "usage: tightknot info [--json] [--tolerance EPS] FILE...\n"
     "\n"
     "Measures each VECT file (\"-\" is standard input): its number of\n"
-    "components and vertices, length, thickness, minrad, ropelength, and how\n"
+    "components and vertices, length, thickness, minrad, ropelength, how\n"
     "many struts and kinks are active, that is within a relative tolerance of\n"
-    "the thickness.\n"
+    "the thickness, and its knot or link type.\n"
     "\n"
     "  thickness   tube diameter: min(2 * minrad, shortest doubly critical\n"
     "              self-distance)\n"
@@ -89,12 +91,23 @@ static const char info_help[] =
     "  ropelength  length / tube radius = 2 * length / thickness\n"
     "  struts      admissible edge pairs at distance <= thickness * (1 + EPS)\n"
     "  kinks       vertices with 2 * minrad <= thickness * (1 + EPS)\n"
+    "  type        for a knot its determinant |Delta(-1)| and Alexander\n"
+    "              polynomial Delta(t) (normalised so that Delta(1) = 1):\n"
+    "              \"det 3, 1 - t + t^2\" is the trefoil; for a link the\n"
+    "              determinant of each component and the linking number of\n"
+    "              each pair: \"det 1 1, lk 0-1: 1\" is the Hopf link.  \"?\"\n"
+    "              for what cannot be told (an open component, a projection\n"
+    "              with too many crossings, strands that (nearly) meet)\n"
     "\n"
     "Options:\n"
     "  --json            one JSON object per file and line, with the names\n"
     "                    file, components, vertices, length, thickness, minrad,\n"
     "                    ropelength, struts, kinks (full precision; null for a\n"
-    "                    value that is not finite)\n"
+    "                    value that is not finite) and invariants:\n"
+    "                    {\"alexander\": [[1, -1, 1]] (each component's\n"
+    "                    coefficients of 1, t, t^2, ...), \"alexander_text\",\n"
+    "                    \"determinants\", \"linking\" (the matrix of linking\n"
+    "                    numbers), \"complete\"} (null for what cannot be told)\n"
     "  --tolerance EPS   relative tolerance for struts and kinks, >= 0\n"
     "                    (default 1e-4)\n"
     "  -h, --help        show this help\n"
@@ -221,12 +234,19 @@ static const char tighten_help[] =
     "  --json                  print one JSON object with the final figures:\n"
     "                          ropelength, length, thickness, minrad, vertices,\n"
     "                          components, steps, seconds, residual, struts,\n"
-    "                          kinks, stop_reason\n"
+    "                          kinks, stop_reason, and invariants: {start,\n"
+    "                          result}, the knot or link type of the input and\n"
+    "                          of the result, as in 'tightknot info --json'\n"
     "  -h, --help              show this help\n"
     "\n"
     "A progress line goes to standard error when it is a terminal.  The\n"
     "conventions are those of 'tightknot info': thickness is the tube\n"
     "diameter, ropelength = 2 * length / thickness.\n"
+    "\n"
+    "The knot or link type (see 'tightknot help info') is checked after every\n"
+    "resampling and at the end: a run whose type changed (a strand passed\n"
+    "through another) fails, saying which polynomial or linking number\n"
+    "changed.\n"
     "\n"
     "Exit status: 0 success, 1 usage error, 2 bad input or a failed run.\n"
     "\n"
@@ -594,8 +614,45 @@ static int load_and_measure(const char *name, double tolerance, tk_curve **curve
 
 static void print_info_header(int width)
 {
-    printf("%-*s %5s %9s %15s %15s %15s %15s %7s %6s\n", width, "file", "comps",
-           "vertices", "length", "thickness", "minrad", "ropelength", "struts", "kinks");
+    printf("%-*s %5s %9s %15s %15s %15s %15s %7s %6s  %s\n", width, "file", "comps",
+           "vertices", "length", "thickness", "minrad", "ropelength", "struts", "kinks",
+           "type");
+}
+
+/* The type of c in a few words: "det 3, 1 - t + t^2" for a knot, "det 1 1,
+ * lk 0-1: 1" for a link (each component's determinant, each pair's
+ * linking number); "?" for what is not known (inv NULL: nothing is). */
+static void print_type(FILE *f, const tk_curve *c, const tk_invariants *inv)
+{
+    if (!inv || inv->ncomp != c->ncomp) {
+        fputc('?', f);
+        return;
+    }
+    size_t n = inv->ncomp;
+    fputs("det", f);
+    for (size_t a = 0; a < n; a++)
+        if (inv->knot[a].known)
+            fprintf(f, " %lld", inv->knot[a].determinant);
+        else
+            fputs(" ?", f);
+    if (n == 1) {
+        if (inv->knot[0].known) {
+            char poly[1024];
+            tk_alexander_format(&inv->knot[0], poly, sizeof poly);
+            fprintf(f, ", %s", poly);
+        }
+        return;
+    }
+    fputs(", lk", f);
+    for (size_t a = 0; a < n; a++)
+        for (size_t b = a + 1; b < n; b++) {
+            fprintf(f, "%s %zu-%zu: ", a == 0 && b == 1 ? "" : ",", a, b);
+            /* an open component links nothing */
+            if (c->closed[a] && c->closed[b])
+                fprintf(f, "%ld", inv->linking[a * n + b]);
+            else
+                fputc('?', f);
+        }
 }
 
 /* Measures one file and prints its line; the table's header goes out
@@ -610,6 +667,11 @@ static int info_one(const char *name, const cli_args *a, int width, bool *header
     int status = load_and_measure(name, a->tolerance, &c, &m, &struts, &kinks, &nkinks);
     if (status)
         return status;
+    /* A curve whose strands (nearly) meet has no type: shown as unknown,
+     * while its figures still are what they are. */
+    tk_invariants inv = TK_INVARIANTS_INIT;
+    tk_error err;
+    bool typed = tk_invariants_compute(c, &inv, &err) == TK_OK;
     if (a->json) {
         json_t *o = json_object();
         json_object_set_new(o, "file", tk_json_text(name));
@@ -621,15 +683,19 @@ static int info_one(const char *name, const cli_args *a, int width, bool *header
         json_object_set_new(o, "ropelength", tk_json_number(m.ropelength));
         json_object_set_new(o, "struts", json_integer((json_int_t)struts.count));
         json_object_set_new(o, "kinks", json_integer((json_int_t)nkinks));
+        json_object_set_new(o, "invariants", tk_json_invariants(typed ? &inv : NULL));
         status = print_json(o);
     } else {
         if (!*header_done)
             print_info_header(width);
         *header_done = true;
-        printf("%-*s %5zu %9zu %15.9g %15.9g %15.9g %15.9g %7zu %6zu\n", width, name,
+        printf("%-*s %5zu %9zu %15.9g %15.9g %15.9g %15.9g %7zu %6zu  ", width, name,
                c->ncomp, c->nvert, m.length, m.thickness, m.minrad, m.ropelength,
                struts.count, nkinks);
+        print_type(stdout, c, typed ? &inv : NULL);
+        putchar('\n');
     }
+    tk_invariants_free(&inv);
     tk_strut_list_free(&struts);
     free(kinks);
     tk_curve_free(&c);
@@ -993,6 +1059,10 @@ static int cmd_tighten(int argc, char **argv)
         json_object_set_new(o, "struts", json_integer((json_int_t)last->struts));
         json_object_set_new(o, "kinks", json_integer((json_int_t)last->kinks));
         json_object_set_new(o, "stop_reason", json_string(tk_stop_reason_name(why)));
+        json_object_set_new(o, "invariants",
+                            json_pack("{s:o, s:o}", "start",
+                                      tk_json_invariants(tk_run_type_start(run)), "result",
+                                      tk_json_invariants(tk_run_type_latest(run))));
         if (print_json(o) != EXIT_OK)
             status = EXIT_INPUT;
     } else {
@@ -1002,6 +1072,9 @@ static int cmd_tighten(int argc, char **argv)
                last->ropelength, last->length, last->thickness, last->minrad);
         printf("  vertices %zu  components %zu  struts %zu  kinks %zu  residual %.3g\n",
                fin->nvert, fin->ncomp, last->struts, last->kinks, last->residual);
+        printf("  type ");
+        print_type(stdout, fin, tk_run_type_latest(run));
+        putchar('\n');
     }
 done:
     if (w.log && fclose(w.log) != 0) {
