@@ -19,6 +19,10 @@
  *   tighten.c   the step's figures, the history, the stop criteria (and
  *               the schedule's other cues to move on: a stall, a spent
  *               share of the budget)
+ *   escape.c    when the final polygon has converged: a deformation of the
+ *               best curve so far, tightened again from before the next
+ *               step (carried out by schedule.c), and the best curve
+ *               restored when the run stops
  *
  * Each room owns the sub-struct named after it: only its file writes it,
  * the others read.  The shared part (the curve, the trial curve, the strut
@@ -34,6 +38,7 @@
 #include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdlib.h>
 
 #include "tk/invariants.h"
@@ -116,7 +121,21 @@ struct tk_run {
         int coarse_levels;   /* of them at the start */
         bool move_on;        /* refine before the next step */
         size_t resampled_from; /* history entries before the last resampling */
+        double share_from;   /* budget spent when the current schedule began
+                                (an escape starts it again) */
     } schedule;
+
+    struct {             /* escape.c */
+        uint64_t rng;        /* the deformations' random stream */
+        tk_curve *best;      /* the best final polygon so far, or NULL */
+        tk_step_report best_report;
+        int best_polish;     /* its polishing level */
+        bool due;            /* deform before the next step */
+        tk_escape *log;      /* one per try */
+        size_t nlog, log_capacity;
+        int improved;
+        double type_seconds; /* the deformations' types checked */
+    } escape;
 
     struct {             /* tighten.c */
         tk_step_report latest;
@@ -172,8 +191,7 @@ static inline double tk_norm(const double *v, size_t n)
 /* ---- tighten.c ---- */
 
 /* The run's curve still has the start's knot or link type; else TK_ETYPE
- * with a message that begins with `when` ("resampling to 400 vertices").
- * Skipped when the curve has not moved since the last check. */
+ * with a message that begins with `when` ("resampling to 400 vertices"). */
 int tk_type_check(tk_run *r, const char *when, tk_error *err);
 
 /* ---- active.c ---- */
@@ -230,6 +248,22 @@ void tk_recovery_rescale(tk_run *r, double worst);
 int tk_recovery_fit(tk_run *r, size_t vertices, tk_error *err);
 void tk_recovery_free(tk_run *r);
 
+/* ---- escape.c ---- */
+
+/* Whether the final polygon has converged: its ropelength fell by less
+ * than a set fraction over a window of steps. */
+bool tk_escape_converged(const tk_run *r);
+/* Asks for an escape before the next step when tries and budget remain
+ * (the attempt that converged is noted); false when none is left. */
+bool tk_escape_ask(tk_run *r);
+/* Before a step: the deformation (or, with no tries left, the best curve
+ * back) when asked for. */
+int tk_escape_before_step(tk_run *r, tk_error *err);
+/* The run has stopped: the best curve found becomes its result
+ * (*restored when that is not the curve it stopped on). */
+int tk_escape_finish(tk_run *r, bool *restored, tk_error *err);
+void tk_escape_free(tk_run *r);
+
 /* ---- schedule.c ---- */
 
 /* The run's curve from `start`: resampled (to the coarsest level's count)
@@ -237,6 +271,13 @@ void tk_recovery_free(tk_run *r);
 int tk_schedule_start(tk_run *r, const tk_curve *start, tk_error *err);
 /* Resizes the shared part and the rooms' vectors to the run's curve. */
 int tk_schedule_fit(tk_run *r, tk_error *err);
+/* The run's curve replaced by `curve` (taken over): with `coarse` the
+ * schedule starts again from its coarsest level (the curve resampled to
+ * it), else the curve keeps its vertices and the polishing level is
+ * `polish`; made feasible by scaling, type-checked. */
+int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_error *err);
+/* The fraction of the step or time budget spent (0 without one). */
+double tk_schedule_spent(const tk_run *r);
 /* Before a step: refines or re-resolves if due. */
 int tk_schedule_before_step(tk_run *r, tk_error *err);
 /* After a step's motion: polishing (or, on a coarse polygon, moving on). */

@@ -251,10 +251,8 @@ static int refine(tk_run *r, tk_error *err)
  * share is an equal part of the budget.  A budget too small for that (a
  * step or two) is overrun by one step per level, so the run still ends on
  * the polygon of its resolution. */
-bool tk_schedule_share_spent(const tk_run *r)
+double tk_schedule_spent(const tk_run *r)
 {
-    if (r->schedule.coarse_level == 0)
-        return false;
     const tk_options *o = &r->opt;
     const tk_step_report *s = &r->life.latest;
     double spent = 0.0;
@@ -262,8 +260,49 @@ bool tk_schedule_share_spent(const tk_run *r)
         spent = fmax(spent, (double)s->step / (double)o->max_steps);
     if (o->max_seconds > 0.0)
         spent = fmax(spent, s->seconds / o->max_seconds);
+    return spent;
+}
+
+bool tk_schedule_share_spent(const tk_run *r)
+{
+    if (r->schedule.coarse_level == 0)
+        return false;
+    /* the shares of what was left when this schedule began */
+    double from = r->schedule.share_from;
+    double spent = from < 1.0 ? (tk_schedule_spent(r) - from) / (1.0 - from) : 1.0;
     int levels = r->schedule.coarse_levels;
     return spent >= (double)(levels - r->schedule.coarse_level + 1) / (double)(levels + 1);
+}
+
+int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_error *err)
+{
+    tk_curve_free(&r->shared.curve);
+    r->shared.curve = curve;
+    r->schedule.share_from = tk_schedule_spent(r);
+    r->schedule.move_on = false;
+    size_t count = curve->nvert;
+    if (coarse && r->schedule.coarse_levels > 0) {
+        r->schedule.coarse_level = r->schedule.coarse_levels;
+        double rope = r->opt.re_resolve > 0.0 ? r->life.latest.ropelength
+                                              : r->schedule.start_ropelength;
+        count = (size_t)ceil(resolution_now(r) * rope);
+    }
+    tk_measure m;
+    int rc = measure(curve, &m, err);
+    if (rc)
+        return rc;
+    /* a deformed curve is thinner: scaled to the tube, as at the start */
+    if (m.thickness < r->tau * (1.0 - tk_tolerance_overstep(r)))
+        tk_curve_scale(curve, r->opt.autoscale_margin * r->tau / m.thickness);
+    rc = count != curve->nvert ? resample_to(r, count, err) : tk_schedule_fit(r, err);
+    if (rc)
+        return rc;
+    r->schedule.polish_level = coarse ? 0 : polish;
+    r->schedule.polish_from = r->life.nhistory;
+    r->schedule.resampled_from = r->life.nhistory;
+    r->schedule.resolved_at = r->life.latest.ropelength;
+    tk_stepping_reset(r);
+    return tk_type_check(r, "an escape's deformation", err);
 }
 
 /* Re-resolution during the run: the start was resampled to `resolution`

@@ -55,6 +55,9 @@ static int check_options(const tk_options *o, tk_error *err)
                             "0 < active < 0.5");
     if (!(o->equalise >= 0.0) || !isfinite(o->equalise))
         return tk_error_set(err, TK_EINVAL, "equalise gain must be >= 0");
+    if (o->escapes < 0 || o->escapes > 1000)
+        return tk_error_set(err, TK_EINVAL, "escapes must be between 0 and 1000 (got %d)",
+                            o->escapes);
     if (!(o->re_resolve >= 0.0 && o->re_resolve < 1.0))
         return tk_error_set(err, TK_EINVAL, "re_resolve must be in [0, 1) (got %g)",
                             o->re_resolve);
@@ -78,6 +81,7 @@ void tk_run_free(tk_run **p)
     tk_active_free(r);
     tk_motion_free(r);
     tk_recovery_free(r);
+    tk_escape_free(r);
     free(r->life.history);
     free(r->life.snapshots);
     free(r->life.snapshot_steps);
@@ -98,6 +102,7 @@ static int record(tk_run *r, tk_step_report *rep, tk_error *err)
     rep->minrad = m.minrad;
     rep->ropelength = m.ropelength;
     rep->vertices = r->shared.curve->nvert;
+    rep->escapes = (int)r->escape.nlog;
     rep->seconds = tk_clock() - r->life.started;
     if (r->life.nhistory == r->life.history_capacity) {
         size_t cap = r->life.history_capacity ? 2 * r->life.history_capacity : 256;
@@ -147,6 +152,7 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
     atomic_init(&r->life.cancel, 0);
     r->life.started = tk_clock();
     r->type.checked_step = -1;
+    r->escape.rng = opts->seed;
     rc = tk_nnls_new(&r->shared.nnls, err);
     if (!rc)
         rc = tk_schedule_start(r, start, err);
@@ -229,6 +235,13 @@ static void check_stop(tk_run *r)
     }
     if (stop == TK_STOP_NONE && tk_stepping_stalled(r) && !tk_schedule_move_on(r))
         stop = TK_STOP_STALLED;
+    /* converged on the final polygon: an escape, while tries and budget
+     * remain, rather than a stop */
+    bool converged = stop == TK_STOP_RESIDUAL || stop == TK_STOP_CHANGE ||
+                     stop == TK_STOP_STALLED ||
+                     (stop == TK_STOP_NONE && tk_escape_converged(r));
+    if (converged && tk_escape_ask(r))
+        stop = TK_STOP_NONE;
     if (tk_schedule_share_spent(r)) {
         tk_schedule_move_on(r);
         /* a stop on the budget has spent >= 1, above every share */
@@ -241,8 +254,6 @@ static void check_stop(tk_run *r)
 int tk_type_check(tk_run *r, const char *when, tk_error *err)
 {
     const tk_curve *c = r->shared.curve;
-    if (r->type.checked_step == r->life.latest.step && r->type.checked_vertices == c->nvert)
-        return TK_OK;
     double t0 = tk_clock();
     tk_error why;
     int rc = tk_invariants_compute(c, &r->type.latest, &why);
@@ -256,13 +267,47 @@ int tk_type_check(tk_run *r, const char *when, tk_error *err)
     return TK_OK;
 }
 
-/* A run that stops (for any reason but a failure) has its result's type
- * checked against the start's. */
+/* The figures of the best curve an escape found, put back when the run
+ * stopped on another: its active set and forces, recorded as one more
+ * entry of the history (step size 0). */
+static int record_restored(tk_run *r, tk_error *err)
+{
+    tk_step_report rep = {0};
+    rep.step = r->life.latest.step + 1;
+    tk_curve *c = r->shared.curve;
+    tk_strut_finder_refit(r->shared.finder, c);
+    int rc = tk_active_find(r, c, &r->active.set, err);
+    if (!rc)
+        rc = tk_motion_resolve(r, &rep, false, err);
+    if (!rc)
+        rc = tk_recovery_violation(r, c, &rep.violation, err);
+    rep.struts = r->active.set.struts.count;
+    if (!rc)
+        rc = tk_active_report(r, err);
+    rep.kinks = r->active.nreport;
+    if (!rc)
+        rc = record(r, &rep, err);
+    if (!rc && r->life.progress)
+        (void)r->life.progress(&r->life.latest, r->life.user); /* stopping anyway */
+    return rc;
+}
+
+/* A run that stops (for any reason but a failure) returns the best curve
+ * it found, its type checked against the start's. */
 static int check_result(tk_run *r, tk_error *err)
 {
     if (r->life.stop == TK_STOP_NONE || r->life.stop == TK_STOP_FAILED)
         return TK_OK;
-    int rc = tk_type_check(r, "tightening changed the knot or link type", err);
+    /* checked already, unless the run went on since */
+    if (r->type.checked_step == r->life.latest.step &&
+        r->type.checked_vertices == r->shared.curve->nvert)
+        return TK_OK;
+    bool restored = false;
+    int rc = tk_escape_finish(r, &restored, err);
+    if (!rc && restored)
+        rc = record_restored(r, err);
+    if (!rc)
+        rc = tk_type_check(r, "tightening changed the knot or link type", err);
     if (rc)
         r->life.stop = TK_STOP_FAILED;
     return rc;
@@ -289,7 +334,9 @@ static int step(tk_run *r, tk_error *err)
     }
     tk_step_report rep = {0};
     rep.step = r->life.latest.step + 1;
-    int rc = tk_schedule_before_step(r, err);
+    int rc = tk_escape_before_step(r, err);
+    if (!rc)
+        rc = tk_schedule_before_step(r, err);
     if (rc) {
         r->life.stop = TK_STOP_FAILED;
         return rc;
@@ -389,7 +436,7 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out)
         .nnls_solves = r->motion.nnls_solves,
         .nnls_iterations = r->motion.nnls_iterations,
         .factorisations = r->motion.factorisations,
-        .invariants = r->type.seconds,
+        .invariants = r->type.seconds + r->escape.type_seconds,
     };
 }
 

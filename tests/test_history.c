@@ -72,6 +72,10 @@ static void mix_report(digest *d, const tk_step_report *s)
     mix_double(d, s->violation);
     mix_size(d, (size_t)s->corrections);
     mix_size(d, s->vertices);
+    /* mixed only when there are any, so that the digests of runs without
+     * escapes are those recorded before escapes existed */
+    if (s->escapes)
+        mix_size(d, (size_t)s->escapes);
 }
 
 static void mix_end(digest *d, const tk_run *run)
@@ -90,6 +94,15 @@ static void mix_end(digest *d, const tk_run *run)
     for (size_t k = 0; k < nk; k++) {
         mix_size(d, kinks[k].vertex);
         mix_double(d, kinks[k].force);
+    }
+    size_t ne = 0;
+    const tk_escape *e = tk_run_escapes(run, &ne);
+    for (size_t k = 0; k < ne; k++) {
+        mix_size(d, (size_t)e[k].step);
+        mix_double(d, e[k].from);
+        mix_double(d, e[k].amplitude);
+        mix_double(d, e[k].reached);
+        mix_size(d, e[k].improved);
     }
     for (size_t k = 0; k < tk_run_snapshot_count(run); k++) {
         long step = 0;
@@ -167,9 +180,12 @@ static tk_curve *open_arc(void)
     return c;
 }
 
+/* The flow itself is pinned without escapes (they start only once it
+ * has converged); one case below has them. */
 static void autoscaled(tk_options *o)
 {
     o->autoscale = true;
+    o->escapes = 0;
 }
 
 /* Coarse to fine with two coarse levels, moved on by the budget and by
@@ -227,6 +243,17 @@ static void with_snapshots(tk_options *o)
     o->snapshot_every = 40;
 }
 
+/* Escapes from the polished Hopf link: deformed, tightened again coarse
+ * to fine, the best kept and restored at the stop. */
+static void escaping(tk_options *o)
+{
+    o->autoscale = true;
+    o->resolution = 3;
+    o->escapes = 2;
+    o->seed = 7;
+    o->max_steps = 1500;
+}
+
 static void short_budget(tk_options *o)
 {
     o->autoscale = true;
@@ -242,6 +269,7 @@ static const history_case cases[] = {
     {"hopf-coarse-to-fine-converged", false, hopf, coarse_to_fine_to_convergence},
     {"tight-hopf-residual", true, tight_hopf, until_residual},
     {"borromean", true, borromean, short_budget},
+    {"hopf-escapes", false, hopf, escaping},
 };
 #define NCASES (sizeof cases / sizeof cases[0])
 

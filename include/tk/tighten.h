@@ -82,12 +82,21 @@ typedef struct tk_options {
                                     ropelength) and double them each time the
                                     ropelength all but stops falling, up to
                                     the resolution's count */
+    /* Escapes from critical points that are not the minimum (escape.c):
+     * each time the ropelength all but stops falling on the final polygon
+     * (or a convergence criterion is met) while tries and budget remain,
+     * the best curve so far is deformed at random, made feasible and
+     * tightened again (coarse to fine where the run is); the run returns
+     * the best curve found.  0 turns them off. */
+    int escapes;                 /* most tries */
+    unsigned long long seed;     /* of the random deformations: the same
+                                    seed, the same run */
 } tk_options;
 
 #define TK_OPTIONS_INIT                                                                  \
     {                                                                                    \
         0.5, 1.0, 0.0, false, 1.002, 0, 0.0, 0.0, 0.0, 20, 3e-4, 1e-5, 1e-6, 0.5, 0, 0.0, \
-            true                                                                         \
+            true, 8, 1                                                                   \
     }
 
 /* Why a run stopped. */
@@ -120,6 +129,7 @@ typedef struct tk_step_report {
     double violation;        /* worst constraint violation after the step / tau */
     int corrections;         /* Newton iterations after the step */
     size_t vertices;
+    int escapes;             /* escapes tried so far (tk_run_escapes) */
 } tk_step_report;
 
 typedef struct tk_run tk_run;
@@ -155,6 +165,19 @@ const tk_step_report *tk_run_history(const tk_run *r, size_t *count);
 const tk_strut *tk_run_struts(const tk_run *r, size_t *count);
 const tk_kink *tk_run_kinks(const tk_run *r, size_t *count);
 tk_stop_reason tk_run_stop_reason(const tk_run *r);
+
+/* One escape: where it started, the best ropelength then, and what its
+ * tightening reached on the final polygon (NAN while under way or when
+ * the run stopped first). */
+typedef struct tk_escape {
+    long step;          /* the step after which the deformation was made */
+    double from;        /* the best ropelength when it started */
+    double amplitude;   /* of the deformation, in tube diameters */
+    double reached;
+    bool improved;      /* reached < from */
+} tk_escape;
+
+const tk_escape *tk_run_escapes(const tk_run *r, size_t *count);
 
 /* The knot or link type of the start as given, and of the run's curve at
  * the last check (after every resampling and at every stop; the start's

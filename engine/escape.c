@@ -1,0 +1,227 @@
+/* Escapes from critical points that are not the minimum.  See run.h for
+ * the rooms of the flow.
+ *
+ * The flow is a gradient flow: it stops wherever the resolved gradient
+ * vanishes, and a start with a symmetry keeps it, so it can settle in a
+ * critical configuration far from tight (the parametric figure-eight
+ * ((2 + cos 2t) cos 3t, (2 + cos 2t) sin 3t, sin 4t) at 56.10 with 12
+ * kinks at the curvature bound; T(2,5) from the round torus at 48.21,
+ * keeping its five-fold symmetry; the tight values are 42.10 and 47.21).
+ * Once the final polygon has all but stopped tightening, the best curve
+ * so far is deformed by a smooth random displacement (a few Fourier
+ * modes along each component, so that strands move together rather than
+ * against each other), made feasible by scaling, and tightened again
+ * from the coarsest level of the schedule, where kinks are least stiff.
+ * Measured on those two starts at resolution 5: the figure-eight left
+ * 56.10 for 42.10, T(2,5) left 48.21 for 47.22; a deformation that keeps
+ * 90% of the thickness and no coarse restart both ended back in the same
+ * configuration (48.208, 55.13).  The deformation's size is the largest
+ * (from one diameter down by 0.7 each time) that keeps three quarters of
+ * the thickness and the knot type. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rng.h"
+#include "run.h"
+#include "tk/thickness.h"
+
+/* Converged: the ropelength fell by less than ESCAPE_CHANGE (relative)
+ * over ESCAPE_WINDOW steps of the final polygon. */
+#define ESCAPE_WINDOW 300
+#define ESCAPE_CHANGE 2e-5
+/* The deformation: ESCAPE_MODES Fourier modes per component, mode k with
+ * standard deviation amplitude / k per coordinate; the amplitude starts
+ * at ESCAPE_AMPLITUDE diameters and shrinks by ESCAPE_SHRINK until the
+ * curve keeps ESCAPE_THICKNESS of its thickness and its type, at most
+ * ESCAPE_SIZES times. */
+#define ESCAPE_MODES 3
+#define ESCAPE_AMPLITUDE 1.0
+#define ESCAPE_SHRINK 0.7
+#define ESCAPE_THICKNESS 0.75
+#define ESCAPE_SIZES 40
+/* No escape starts with less than this fraction of the budget left. */
+#define ESCAPE_BUDGET_LEFT 0.1
+
+void tk_escape_free(tk_run *r)
+{
+    tk_curve_free(&r->escape.best);
+    free(r->escape.log);
+}
+
+bool tk_escape_converged(const tk_run *r)
+{
+    size_t n = r->life.nhistory;
+    if (!tk_schedule_final(r) || n <= r->schedule.resampled_from + ESCAPE_WINDOW)
+        return false;
+    double before = r->life.history[n - 1 - ESCAPE_WINDOW].ropelength;
+    double now = r->life.history[n - 1].ropelength;
+    return before - now < ESCAPE_CHANGE * now;
+}
+
+/* The run's curve, on the final polygon, as the result of the try under
+ * way (or of the first tightening): logged, and kept if the best. */
+static int note(tk_run *r, tk_error *err)
+{
+    if (!tk_schedule_final(r))
+        return TK_OK;
+    const tk_step_report *s = &r->life.latest;
+    if (r->escape.nlog > 0) {
+        tk_escape *e = &r->escape.log[r->escape.nlog - 1];
+        if (isnan(e->reached) || s->ropelength < e->reached) {
+            bool was = e->improved;
+            e->reached = s->ropelength;
+            e->improved = e->reached < e->from;
+            r->escape.improved += e->improved && !was;
+        }
+    }
+    if (r->escape.best && !(s->ropelength < r->escape.best_report.ropelength))
+        return TK_OK;
+    tk_curve_free(&r->escape.best);
+    int rc = tk_curve_copy(r->shared.curve, &r->escape.best, err);
+    r->escape.best_report = *s;
+    r->escape.best_polish = r->schedule.polish_level;
+    return rc;
+}
+
+static bool tries_left(const tk_run *r)
+{
+    return r->escape.nlog < (size_t)r->opt.escapes &&
+           tk_schedule_spent(r) < 1.0 - ESCAPE_BUDGET_LEFT;
+}
+
+bool tk_escape_ask(tk_run *r)
+{
+    if (r->opt.escapes <= 0 || r->escape.due)
+        return r->escape.due;
+    if (note(r, NULL) != TK_OK)
+        return false; /* out of memory for the copy: no escape */
+    bool behind = r->escape.best_report.ropelength < r->life.latest.ropelength;
+    r->escape.due = tries_left(r) || behind;
+    return r->escape.due;
+}
+
+/* c displaced by the modes coef (per component, ESCAPE_MODES x 2 x 3
+ * normals) times amplitude, as a function of arclength. */
+static void deform(tk_curve *c, const tk_curve *from, const double *coef, double amplitude)
+{
+    memcpy(c->xyz, from->xyz, 3 * from->nvert * sizeof *c->xyz);
+    for (size_t comp = 0; comp < c->ncomp; comp++) {
+        const double *a = coef + comp * ESCAPE_MODES * 6;
+        size_t n = tk_curve_comp_vertices(c, comp);
+        double length = tk_curve_comp_length(from, comp), s = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            double phase = 2.0 * M_PI * s / length;
+            double *v = tk_curve_vertex(c, c->offset[comp] + i);
+            bool end = !c->closed[comp] && (i == 0 || i + 1 == n);
+            for (int k = 1; k <= ESCAPE_MODES && !end; k++)
+                for (int d = 0; d < 3; d++)
+                    v[d] += amplitude / k *
+                            (a[(k - 1) * 6 + d] * cos(k * phase) +
+                             a[(k - 1) * 6 + 3 + d] * sin(k * phase));
+            if (i + 1 < n)
+                s += tk_curve_edge_length(from, comp, i);
+        }
+    }
+}
+
+/* The largest deformation of the best curve that keeps its type and
+ * ESCAPE_THICKNESS of its thickness, into *out. */
+static int deformed_best(tk_run *r, tk_curve **out, double *amplitude, tk_error *err)
+{
+    const tk_curve *best = r->escape.best;
+    size_t ncoef = best->ncomp * ESCAPE_MODES * 6;
+    double *coef = malloc(ncoef * sizeof *coef);
+    tk_invariants type = TK_INVARIANTS_INIT;
+    int rc = coef ? tk_curve_copy(best, out, err)
+                  : tk_error_set(err, TK_ENOMEM, "out of memory for a deformation");
+    for (size_t i = 0; !rc && i < ncoef; i++)
+        coef[i] = tk_rng_normal(&r->escape.rng);
+    double a = ESCAPE_AMPLITUDE * r->tau;
+    bool found = false;
+    for (int size = 0; !rc && !found && size < ESCAPE_SIZES; size++, a *= ESCAPE_SHRINK) {
+        deform(*out, best, coef, a);
+        tk_measure m;
+        tk_error why;
+        if (tk_thickness_measure(*out, NULL, &m, &why) != TK_OK ||
+            !(m.thickness >= ESCAPE_THICKNESS * r->escape.best_report.thickness))
+            continue;
+        double t0 = tk_clock();
+        int type_rc = tk_invariants_compute(*out, &type, &why);
+        if (!type_rc)
+            type_rc = tk_invariants_compare(&r->type.start, &type, &why);
+        r->escape.type_seconds += tk_clock() - t0;
+        found = type_rc == TK_OK;
+        *amplitude = a / r->tau;
+    }
+    free(coef);
+    tk_invariants_free(&type);
+    if (!rc && !found) {
+        /* nothing that small changes it: tighten the best again as it is */
+        memcpy((*out)->xyz, best->xyz, 3 * best->nvert * sizeof *best->xyz);
+        *amplitude = 0.0;
+    }
+    if (rc)
+        tk_curve_free(out);
+    return rc;
+}
+
+int tk_escape_before_step(tk_run *r, tk_error *err)
+{
+    if (!r->escape.due)
+        return TK_OK;
+    r->escape.due = false;
+    if (!r->escape.best)
+        return TK_OK;
+    tk_curve *curve = NULL;
+    if (!tries_left(r)) {
+        /* the tries are spent and the last ended behind: polish the best */
+        int rc = tk_curve_copy(r->escape.best, &curve, err);
+        return rc ? rc : tk_schedule_restart(r, curve, false, r->escape.best_polish, err);
+    }
+    if (r->escape.nlog == r->escape.log_capacity) {
+        size_t cap = r->escape.log_capacity ? 2 * r->escape.log_capacity : 8;
+        tk_escape *grown = realloc(r->escape.log, cap * sizeof *grown);
+        if (!grown)
+            return tk_error_set(err, TK_ENOMEM, "out of memory for the escapes");
+        r->escape.log = grown;
+        r->escape.log_capacity = cap;
+    }
+    double amplitude = 0.0;
+    int rc = deformed_best(r, &curve, &amplitude, err);
+    if (rc)
+        return rc;
+    r->escape.log[r->escape.nlog++] = (tk_escape){
+        .step = r->life.latest.step,
+        .from = r->escape.best_report.ropelength,
+        .amplitude = amplitude,
+        .reached = NAN,
+        .improved = false,
+    };
+    return tk_schedule_restart(r, curve, true, 0, err);
+}
+
+int tk_escape_finish(tk_run *r, bool *restored, tk_error *err)
+{
+    *restored = false;
+    if (r->escape.nlog == 0)
+        return TK_OK;
+    int rc = note(r, err);
+    if (rc || !r->escape.best)
+        return rc;
+    if (tk_schedule_final(r) &&
+        !(r->escape.best_report.ropelength < r->life.latest.ropelength))
+        return TK_OK;
+    tk_curve *curve = NULL;
+    rc = tk_curve_copy(r->escape.best, &curve, err);
+    if (!rc)
+        rc = tk_schedule_restart(r, curve, false, r->escape.best_polish, err);
+    *restored = rc == TK_OK;
+    return rc;
+}
+
+const tk_escape *tk_run_escapes(const tk_run *r, size_t *count)
+{
+    *count = r->escape.nlog;
+    return r->escape.log;
+}
