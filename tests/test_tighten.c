@@ -717,6 +717,66 @@ START_TEST(the_knot_type_is_checked)
 }
 END_TEST
 
+/* Escapes: a converged Hopf link deformed and tightened again; the run
+ * returns the best curve it found (no tighter curve in its log), feasible,
+ * at its own vertex count, with its type; the same seed gives the same
+ * run bit for bit, in any thread. */
+static tk_run *escaping_run(unsigned long long seed)
+{
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_chain(2, 40, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.escapes = 2;
+    o.seed = seed;
+    o.max_steps = quick() ? 900 : 1500;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_msg(tk_run_until(run, NULL, &err) == TK_OK, "%s", err.message);
+    tk_curve_free(&c);
+    return run;
+}
+
+START_TEST(escapes_keep_the_best_and_repeat)
+{
+    tk_run *a = escaping_run(7), *b = escaping_run(7), *other = escaping_run(8);
+    size_t ne = 0;
+    const tk_escape *e = tk_run_escapes(a, &ne);
+    ck_assert_uint_ge(ne, 1);
+    const tk_step_report *end = tk_run_latest(a);
+    ck_assert_int_eq(end->escapes, (int)ne);
+    for (size_t k = 0; k < ne; k++) {
+        printf("escape %zu after step %ld: from %.6f, amplitude %.4f, reached %.6f\n", k,
+               e[k].step, e[k].from, e[k].amplitude, e[k].reached);
+        ck_assert(e[k].amplitude > 0.0 && e[k].amplitude <= 1.0);
+        ck_assert(end->ropelength <= e[k].from * (1.0 + 1e-12));
+        if (!isnan(e[k].reached))
+            ck_assert(end->ropelength <= e[k].reached * (1.0 + 1e-12));
+        ck_assert_int_eq(e[k].improved, e[k].reached < e[k].from);
+    }
+    /* measured independently: feasible, at the start's vertex count */
+    const tk_curve *c = tk_run_curve(a);
+    ck_assert_uint_eq(c->nvert, 80);
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, NULL), TK_OK);
+    ck_assert(m.thickness >= 1.0 - 1e-5);
+    ck_assert(fabs(m.ropelength - end->ropelength) <= 1e-9 * end->ropelength);
+    tk_error err;
+    ck_assert_int_eq(tk_invariants_compare(tk_run_type_start(a), tk_run_type_latest(a), &err),
+                     TK_OK);
+    /* the same seed, the same run; another seed, another */
+    const tk_curve *cb = tk_run_curve(b), *co = tk_run_curve(other);
+    ck_assert_uint_eq(cb->nvert, c->nvert);
+    ck_assert(memcmp(c->xyz, cb->xyz, 3 * c->nvert * sizeof *c->xyz) == 0);
+    ck_assert(co->nvert != c->nvert ||
+              memcmp(c->xyz, co->xyz, 3 * c->nvert * sizeof *c->xyz) != 0);
+    tk_run_free(&a);
+    tk_run_free(&b);
+    tk_run_free(&other);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("tighten");
@@ -727,6 +787,7 @@ int main(void)
     tcase_add_test(tc, history_and_snapshots);
     tcase_add_test(tc, timing_accounts_for_the_run);
     tcase_add_test(tc, the_knot_type_is_checked);
+    tcase_add_test(tc, escapes_keep_the_best_and_repeat);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
     tcase_add_test(tc, cancellation_stops_within_one_step);
