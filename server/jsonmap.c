@@ -53,7 +53,21 @@ json_t *tk_json_step(const tk_step_report *s)
     json_object_set_new(o, "violation", tk_json_number(s->violation));
     json_object_set_new(o, "corrections", json_integer(s->corrections));
     json_object_set_new(o, "vertices", json_integer((json_int_t)s->vertices));
+    json_object_set_new(o, "escapes", json_integer(s->escapes));
     return o;
+}
+
+json_t *tk_json_escapes(const tk_escape *e, size_t count)
+{
+    json_t *list = json_array();
+    for (size_t k = 0; list && k < count; k++)
+        json_array_append_new(list, json_pack("{s:I, s:o, s:o, s:o, s:b}", "step",
+                                              (json_int_t)e[k].step, "from",
+                                              tk_json_number(e[k].from), "amplitude",
+                                              tk_json_number(e[k].amplitude), "reached",
+                                              tk_json_number(e[k].reached), "improved",
+                                              e[k].improved));
+    return list;
 }
 
 /* Arclength at the start of every edge, components laid end to end:

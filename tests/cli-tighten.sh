@@ -103,7 +103,7 @@ check $? "a run that changes the type: exit $status, $(cat "$tmp/err")"
 # bad options: exit 1, named
 for args in "--radius 0" "--lambda -1" "--steps 2.5" "--resolution -1" "--time abc" \
     "--residual nan" "--overstep 0.5" "--every 0" "--re-resolve 1" "--re-resolve 0.1" \
-    "--frobnicate 1"; do
+    "--escapes -1" "--escapes 1001" "--seed x" "--frobnicate 1"; do
     # shellcheck disable=SC2086
     "$tk" tighten "$tmp/trefoil.vect" $args >/dev/null 2>"$tmp/err"
     status=$?
@@ -121,6 +121,31 @@ check $? "a malformed file: $(cat "$tmp/err")"
 "$tk" tighten "$tmp/thin.vect" --radius 50 >/dev/null 2>"$tmp/err"
 [ $? -eq 2 ] && grep -qi "thick\|diameter" "$tmp/err"
 check $? "a start thinner than the tube: $(cat "$tmp/err")"
+# escapes: a Hopf link tightened to convergence is deformed and tightened
+# again; the same seed gives the same figures, the result is no worse than
+# any escape reached, and the log counts the tries
+"$tk" generate chain 2 --vertices 40 >"$tmp/hopf.vect"
+for k in 1 2; do
+    "$tk" tighten "$tmp/hopf.vect" --autoscale --steps 1200 --escapes 2 --seed 5 --json \
+        --log "$tmp/escapes$k.tsv" >"$tmp/escapes$k.json" 2>"$tmp/err"
+    check $? "tighten with escapes: $(cat "$tmp/err")"
+done
+cmp -s "$tmp/escapes1.json" "$tmp/escapes2.json" ||
+    [ "$(sed 's/"seconds":[^,]*//' "$tmp/escapes1.json")" = \
+        "$(sed 's/"seconds":[^,]*//' "$tmp/escapes2.json")" ]
+check $? "the same seed, the same run: $(cat "$tmp/escapes1.json") / $(cat "$tmp/escapes2.json")"
+tries=$(grep -o '"improved"' "$tmp/escapes1.json" | wc -l)
+[ "$tries" -ge 1 ] && [ "$(tail -n 1 "$tmp/escapes1.json" | grep -c '"escapes":\[')" -eq 1 ]
+check $? "escapes listed: $(cat "$tmp/escapes1.json")"
+rope=$(value ropelength "$tmp/escapes1.json")
+reached=$(sed 's/.*"escapes":\[//' "$tmp/escapes1.json" | grep -o '"reached":[0-9.e+-]*' |
+    cut -d: -f2)
+for r in $reached; do
+    awk -v a="$rope" -v b="$r" 'BEGIN { exit !(a <= b * (1 + 1e-12)) }'
+    check $? "the result $rope is no worse than an escape's $r"
+done
+[ "$(tail -n 1 "$tmp/escapes1.tsv" | cut -f14)" -eq "$tries" ]
+check $? "the log's escapes column: $(tail -n 1 "$tmp/escapes1.tsv")"
 
 echo "cli-tighten: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

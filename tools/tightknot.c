@@ -220,6 +220,15 @@ static const char tighten_help[] =
     "                    and doubles them whenever the ropelength all but\n"
     "                    stops falling, which gets past slow stretches of\n"
     "                    the flow many times faster\n"
+    "  --escapes N       each time the ropelength all but stops falling on\n"
+    "                    the final polygon, while budget is left: deform\n"
+    "                    the best curve so far at random, tighten it again\n"
+    "                    and keep the better, at most N times (default 8;\n"
+    "                    0: off).  Gets symmetric or contorted starts out of\n"
+    "                    configurations that are critical but not tight;\n"
+    "                    the result is always the best curve found\n"
+    "  --seed S          of the escapes' deformations (default 1): the same\n"
+    "                    seed, the same run\n"
     "Stop criteria (the first met stops the run; default --steps 1000):\n"
     "  --steps N         after N steps\n"
     "  --time SECONDS    after this much wall time\n"
@@ -234,9 +243,11 @@ static const char tighten_help[] =
     "  --json                  print one JSON object with the final figures:\n"
     "                          ropelength, length, thickness, minrad, vertices,\n"
     "                          components, steps, seconds, residual, struts,\n"
-    "                          kinks, stop_reason, and invariants: {start,\n"
+    "                          kinks, stop_reason, invariants: {start,\n"
     "                          result}, the knot or link type of the input and\n"
-    "                          of the result, as in 'tightknot info --json'\n"
+    "                          of the result, as in 'tightknot info --json',\n"
+    "                          and escapes: [{step, from, amplitude, reached,\n"
+    "                          improved}], one per escape tried\n"
     "  -h, --help              show this help\n"
     "\n"
     "A progress line goes to standard error when it is a terminal.  The\n"
@@ -275,12 +286,14 @@ enum {
     OPT_OVERSTEP = 1u << 15,
     OPT_RERESOLVE = 1u << 16,
     OPT_NO_COARSE = 1u << 17,
-    OPT_DISGUISE = 1u << 18
+    OPT_DISGUISE = 1u << 18,
+    OPT_ESCAPES = 1u << 19,
+    OPT_SEED = 1u << 20
 };
 #define TIGHTEN_OPTIONS                                                                   \
     (OPT_JSON | OPT_RADIUS | OPT_LAMBDA | OPT_RESOLUTION | OPT_AUTOSCALE | OPT_STEPS |     \
      OPT_TIME | OPT_RESIDUAL | OPT_OUTPUT | OPT_STRUTS_OUT | OPT_LOG | OPT_SNAPSHOTS |     \
-     OPT_EVERY | OPT_OVERSTEP | OPT_RERESOLVE | OPT_NO_COARSE)
+     OPT_EVERY | OPT_OVERSTEP | OPT_RERESOLVE | OPT_NO_COARSE | OPT_ESCAPES | OPT_SEED)
 
 typedef struct option_spec {
     const char *name;
@@ -308,6 +321,8 @@ static const option_spec option_specs[] = {
     {"re-resolve", OPT_RERESOLVE, true},
     {"no-coarse", OPT_NO_COARSE, false},
     {"disguise", OPT_DISGUISE, true},
+    {"escapes", OPT_ESCAPES, true},
+    {"seed", OPT_SEED, true},
 };
 
 typedef struct cli_args {
@@ -320,6 +335,8 @@ typedef struct cli_args {
     tk_job_options job; /* tighten's run options */
     double overstep;    /* 0: the engine's default */
     double re_resolve;  /* tk_options.re_resolve */
+    int escapes;        /* tk_options.escapes */
+    unsigned long long run_seed; /* tk_options.seed */
     bool no_coarse;     /* tk_options.coarse_to_fine off */
     const char *output, *struts_out, *log_out, *snapshots;
     size_t every;
@@ -456,6 +473,20 @@ static int apply_option(const char *cmd, unsigned flag, const char *value, cli_a
         a->every = (size_t)n;
         return EXIT_OK;
     }
+    case OPT_ESCAPES: {
+        long long n = 0;
+        if (parse_integer(cmd, "--escapes", value, 0, 1000, &n))
+            return EXIT_USAGE;
+        a->escapes = (int)n;
+        return EXIT_OK;
+    }
+    case OPT_SEED: {
+        long long n = 0;
+        if (parse_integer(cmd, "--seed", value, 0, LLONG_MAX, &n))
+            return EXIT_USAGE;
+        a->run_seed = (unsigned long long)n;
+        return EXIT_OK;
+    }
     case OPT_DISGUISE: {
         long long n = 0;
         if (parse_integer(cmd, "--disguise", value, 0, LLONG_MAX, &n))
@@ -498,6 +529,11 @@ static int parse_args(const char *cmd, int argc, char **argv, unsigned allowed,
     a->job = defaults;
     a->overstep = 0.0;
     a->re_resolve = 0.0;
+    {
+        tk_options engine_defaults = TK_OPTIONS_INIT;
+        a->escapes = engine_defaults.escapes;
+        a->run_seed = engine_defaults.seed;
+    }
     a->output = a->struts_out = a->log_out = a->snapshots = NULL;
     a->every = 100;
     a->npos = 0;
@@ -928,10 +964,10 @@ static int tighten_progress(const tk_step_report *s, void *user)
 {
     tighten_watch *w = user;
     if (w->log)
-        fprintf(w->log, "%ld\t%.6f\t%.12g\t%.12g\t%.12g\t%.12g\t%.6g\t%zu\t%zu\t%.6g\t%.6g\t%.3g\t%d\n",
+        fprintf(w->log, "%ld\t%.6f\t%.12g\t%.12g\t%.12g\t%.12g\t%.6g\t%zu\t%zu\t%.6g\t%.6g\t%.3g\t%d\t%d\n",
                 s->step, s->seconds, s->ropelength, s->length, s->thickness, s->minrad,
                 s->residual, s->struts, s->kinks, s->step_size, s->rcond, s->violation,
-                s->corrections);
+                s->corrections, s->escapes);
     if (w->snapshots && s->step % (long)w->every == 0) {
         char path[4096];
         snprintf(path, sizeof path, "%s/step-%06ld.vect", w->snapshots, s->step);
@@ -990,6 +1026,8 @@ static int cmd_tighten(int argc, char **argv)
     }
     run_opts.re_resolve = a.re_resolve;
     run_opts.coarse_to_fine = !a.no_coarse;
+    run_opts.escapes = a.escapes;
+    run_opts.seed = a.run_seed;
     if (a.re_resolve > 0.0 && !(a.job.resolution > 0.0))
         return usage_error("tighten", "--re-resolve needs --resolution (the vertices per unit "
                                       "ropelength to keep)");
@@ -1015,7 +1053,7 @@ static int cmd_tighten(int argc, char **argv)
             return EXIT_INPUT;
         }
         fputs("step\tseconds\tropelength\tlength\tthickness\tminrad\tresidual\tstruts\tkinks\t"
-              "step_size\trcond\tviolation\tcorrections\n",
+              "step_size\trcond\tviolation\tcorrections\tescapes\n",
               w.log);
     }
     tk_run *run = NULL;
@@ -1063,6 +1101,9 @@ static int cmd_tighten(int argc, char **argv)
                             json_pack("{s:o, s:o}", "start",
                                       tk_json_invariants(tk_run_type_start(run)), "result",
                                       tk_json_invariants(tk_run_type_latest(run))));
+        size_t ne = 0;
+        const tk_escape *e = tk_run_escapes(run, &ne);
+        json_object_set_new(o, "escapes", tk_json_escapes(e, ne));
         if (print_json(o) != EXIT_OK)
             status = EXIT_INPUT;
     } else {
@@ -1075,6 +1116,13 @@ static int cmd_tighten(int argc, char **argv)
         printf("  type ");
         print_type(stdout, fin, tk_run_type_latest(run));
         putchar('\n');
+        size_t ne = 0;
+        const tk_escape *e = tk_run_escapes(run, &ne);
+        for (size_t k = 0; k < ne; k++)
+            printf("  escape %zu after step %ld: from %.9g, deformed by %.3g diameters, "
+                   "reached %.9g%s\n",
+                   k + 1, e[k].step, e[k].from, e[k].amplitude, e[k].reached,
+                   e[k].improved ? " (better)" : "");
     }
 done:
     if (w.log && fclose(w.log) != 0) {

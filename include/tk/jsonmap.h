@@ -26,6 +26,10 @@ json_t *tk_json_text(const char *s);
 /* One step's figures, every field of tk_step_report. */
 json_t *tk_json_step(const tk_step_report *s);
 
+/* The escapes a run tried (tk_run_escapes): [{"step", "from", "amplitude",
+ * "reached" (null while under way), "improved"}]. */
+json_t *tk_json_escapes(const tk_escape *e, size_t count);
+
 /* The contacts of curve c:
  *   {"components": [{"vertices", "closed", "length", "start"}],
  *    "struts": [{"edges": [[comp, edge], [comp, edge]], "s", "t", "p", "q",
