@@ -205,7 +205,8 @@ static json_t *maybe_number(bool known, double x)
     return known ? tk_json_number(x) : json_null();
 }
 
-static json_t *job_json(const tk_job *j)
+/* The job's document; `invariants` (taken) is its stored type. */
+static json_t *job_json(const tk_job *j, json_t *invariants)
 {
     const tk_step_report *r = &j->latest;
     bool f = j->has_figures;
@@ -242,11 +243,61 @@ static json_t *job_json(const tk_job *j)
     json_object_set_new(o, "stop_reason",
                         j->stop_reason[0] ? json_string(j->stop_reason) : json_null());
     json_object_set_new(o, "error", j->error[0] ? tk_json_text(j->error) : json_null());
+    json_object_set_new(o, "invariants", invariants ? invariants : json_null());
     json_object_set_new(o, "created", json_time(j->created));
     json_object_set_new(o, "started", json_time(j->started));
     json_object_set_new(o, "finished", json_time(j->finished));
     json_object_set_new(o, "links", links);
     return o;
+}
+
+/* A stored text that does not read back as written: a 500 naming it, and
+ * the store reported damaged (health says so). */
+static mhd_result damaged(tk_api *a, struct MHD_Connection *c, const tk_job *job,
+                          const char *what, const char *why)
+{
+    char message[TK_ERROR_MESSAGE_SIZE];
+    snprintf(message, sizeof message, "the stored %s of job %lld does not read back: %.200s",
+             what, (long long)job->id, why);
+    tk_store_report_damage(a->store, message);
+    return send_problem(a, c, 500, "%s", message);
+}
+
+/* The job's document with its type as the store holds it (written with
+ * the figures every few seconds while the job runs, null before it
+ * starts, and null when the job was deleted since it was read); false,
+ * with a 500 sent, when the store fails or the stored type does not read
+ * back. */
+static bool job_document(tk_api *a, struct MHD_Connection *c, const tk_job *job, json_t **doc,
+                         mhd_result *ret)
+{
+    char *text = NULL;
+    size_t len = 0;
+    tk_error err;
+    int rc = tk_store_text(a->store, job->id, TK_TEXT_INVARIANTS, &text, &len, &err);
+    if (rc && rc != TK_ENOTFOUND) {
+        *ret = send_problem(a, c, 500, "%s", err.message);
+        return false;
+    }
+    json_error_t jerr;
+    json_t *type = text ? json_loadb(text, len, 0, &jerr) : json_null();
+    free(text);
+    if (!type) {
+        *ret = damaged(a, c, job, "knot type", jerr.text);
+        return false;
+    }
+    *doc = job_json(job, type);
+    return true;
+}
+
+static mhd_result send_job(tk_api *a, struct MHD_Connection *c, unsigned status,
+                           const tk_job *job, const char *const *headers)
+{
+    json_t *doc = NULL;
+    mhd_result ret = MHD_NO;
+    if (!job_document(a, c, job, &doc, &ret))
+        return ret;
+    return send_json_headers(a, c, status, doc, "application/json", headers);
 }
 
 /* ---- query parameters ---- */
@@ -406,7 +457,13 @@ static mhd_result list_jobs(tk_api *a, struct MHD_Connection *c)
         tk_job live;
         if (jobs[i].state == TK_JOB_RUNNING && tk_jobs_get(a->jobs, jobs[i].id, &live, NULL) == 0)
             jobs[i] = live;
-        json_array_append_new(list, job_json(&jobs[i]));
+        json_t *doc = NULL;
+        if (!job_document(a, c, &jobs[i], &doc, &ret)) {
+            json_decref(list);
+            free(jobs);
+            return ret;
+        }
+        json_array_append_new(list, doc);
     }
     free(jobs);
     return send_json(a, c, 200,
@@ -430,18 +487,6 @@ static bool accepts_json(struct MHD_Connection *c)
 {
     const char *accept = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_ACCEPT);
     return accept && strstr(accept, "application/json") && !strstr(accept, "text/plain");
-}
-
-/* A stored text that does not read back as written: a 500 naming it, and
- * the store reported damaged (health says so). */
-static mhd_result damaged(tk_api *a, struct MHD_Connection *c, const tk_job *job,
-                          const char *what, const char *why)
-{
-    char message[TK_ERROR_MESSAGE_SIZE];
-    snprintf(message, sizeof message, "the stored %s of job %lld does not read back: %.200s",
-             what, (long long)job->id, why);
-    tk_store_report_damage(a->store, message);
-    return send_problem(a, c, 500, "%s", message);
 }
 
 static mhd_result get_job_vect(tk_api *a, struct MHD_Connection *c, const tk_job *job)
@@ -594,7 +639,7 @@ static mhd_result cancel_job(tk_api *a, struct MHD_Connection *c, int64_t id)
         return send_problem(a, c, 500, "%s", err.message);
     /* a queued job is cancelled now (200); a running one stops within a
      * step (202) */
-    return send_json(a, c, job.state == TK_JOB_CANCELLED ? 200 : 202, job_json(&job));
+    return send_job(a, c, job.state == TK_JOB_CANCELLED ? 200 : 202, &job, NULL);
 }
 
 /* ---- submitting ---- */
@@ -644,16 +689,19 @@ static mhd_result submit(tk_api *a, struct MHD_Connection *c, const char *name,
                                 err.message);
     }
     /* The submission starts a run to see that one can start: when the
-     * engine cannot make the start feasible (TK_ENUMERIC), that is this
-     * input's doing, not a fault of the service. */
-    if (rc == TK_EINVAL || rc == TK_ELIMIT || rc == TK_EPARSE || rc == TK_ENUMERIC)
+     * engine cannot make the start feasible (TK_ENUMERIC), or its
+     * resampling would change the knot type (TK_ETYPE: too few vertices
+     * per unit ropelength), that is this input's doing, not a fault of
+     * the service. */
+    if (rc == TK_EINVAL || rc == TK_ELIMIT || rc == TK_EPARSE || rc == TK_ENUMERIC ||
+        rc == TK_ETYPE)
         return send_input_error(a, c, &err, NULL);
     if (rc)
         return send_problem(a, c, 500, "%s", err.message);
     char location[64];
     snprintf(location, sizeof location, "/v1/jobs/%lld", (long long)job.id);
     const char *headers[] = {MHD_HTTP_HEADER_LOCATION, location, NULL};
-    return send_json_headers(a, c, 202, job_json(&job), "application/json", headers);
+    return send_job(a, c, 202, &job, headers);
 }
 
 static mhd_result post_job(tk_api *a, struct MHD_Connection *c, const request *rq)
@@ -810,7 +858,7 @@ static mhd_result route(tk_api *a, struct MHD_Connection *c, const char *url,
         if (!find_job(a, c, id, &job, &ret))
             return ret;
         if (!*part)
-            return send_json(a, c, 200, job_json(&job));
+            return send_job(a, c, 200, &job, NULL);
         if (!strcmp(part, "struts"))
             return get_job_text_json(a, c, &job, TK_TEXT_CONTACTS);
         if (!strcmp(part, "history"))

@@ -206,7 +206,26 @@ typedef struct job_run {
     long *pending_steps;    /* frames taken since the last write */
     double *pending_xyz;
     size_t pending, pending_cap;
+    tk_invariants input_type; /* a resumed job's: the type of its input
+                                 (the run's start is the stored curve) */
 } job_run;
+
+/* The type the job started from: its input's. */
+static const tk_invariants *start_type(const job_run *jr)
+{
+    return jr->input_type.ncomp > 0 ? &jr->input_type : tk_run_type_start(jr->run);
+}
+
+/* {"start", "result"} as stored (TK_TEXT_INVARIANTS): the input's type
+ * and the run's at its last check.  NULL when out of memory. */
+static char *invariants_text(const job_run *jr)
+{
+    json_t *o = json_pack("{s:o, s:o}", "start", tk_json_invariants(start_type(jr)), "result",
+                          tk_json_invariants(tk_run_type_latest(jr->run)));
+    char *text = tk_json_dump(o, false);
+    json_decref(o);
+    return text;
+}
 
 /* The frames of the job: stored and pending. */
 static size_t job_frames(const job_run *jr)
@@ -255,11 +274,11 @@ static double job_fraction(const tk_job *job)
     return f < 0.0 ? -1.0 : fmin(f, 1.0);
 }
 
-/* Writes the job's figures, curve, contacts, history and new frames to the
- * store, in one transaction: a restart finds them consistent. */
+/* Writes the job's figures, curve, contacts, history, type and new frames
+ * to the store, in one transaction: a restart finds them consistent. */
 static int flush_job(job_run *jr, const tk_job *job, tk_error *err)
 {
-    char *curve = NULL, *contacts = NULL, *hist = NULL;
+    char *curve = NULL, *contacts = NULL, *hist = NULL, *type = NULL;
     int rc = tk_vect_to_string(tk_run_curve(jr->run), &curve, NULL, err);
     const tk_curve *c = tk_run_curve(jr->run);
     size_t ns = 0, nk = 0;
@@ -274,7 +293,8 @@ static int flush_job(job_run *jr, const tk_job *job, tk_error *err)
         contacts = tk_json_dump(o, false);
         json_decref(o);
         hist = history_json(&jr->hist, &job->latest);
-        if (!contacts || !hist)
+        type = invariants_text(jr);
+        if (!contacts || !hist || !type)
             rc = tk_error_set(err, TK_ENOMEM, "out of memory writing job %lld",
                               (long long)job->id);
     }
@@ -290,8 +310,8 @@ static int flush_job(job_run *jr, const tk_job *job, tk_error *err)
     if (!rc) {
         tk_job copy = *job;
         copy.frames = job_frames(jr);
-        rc = tk_store_save(jr->slot->owner->store, &copy, curve, contacts, hist, frames, nnew,
-                           err);
+        rc = tk_store_save(jr->slot->owner->store, &copy, curve, contacts, hist, type, frames,
+                           nnew, err);
         if (!rc) {
             jr->frames_stored += nnew;
             jr->pending = 0;
@@ -301,6 +321,7 @@ static int flush_job(job_run *jr, const tk_job *job, tk_error *err)
     free(curve);
     free(contacts);
     free(hist);
+    free(type);
     return rc;
 }
 
@@ -381,13 +402,42 @@ static int on_step(const tk_step_report *s, void *user)
     return stop;
 }
 
-/* Stores the job as failed with a message. */
-static void fail_job(tk_jobs *j, tk_job *job, const char *message)
+/* Stores the job as failed with a message, and its type when the run was
+ * set up (invariants_text, or NULL). */
+static void fail_job(tk_jobs *j, tk_job *job, const char *message, const char *type)
 {
     job->state = TK_JOB_FAILED;
     job->finished = now_unix();
     snprintf(job->error, sizeof job->error, "%s", message);
-    tk_store_update(j->store, job, NULL);
+    tk_store_save(j->store, job, NULL, NULL, NULL, type, NULL, 0, NULL);
+}
+
+/* Checks that a resumed job's stored curve has its input's type (TK_ETYPE
+ * when not): the run compares its curve with its own start, and after a
+ * crash between a change of type and the run's next check the changed
+ * curve would be that start.  Sets jr->input_type. */
+static int check_resumed_type(tk_jobs *j, const tk_job *job, job_run *jr, tk_error *err)
+{
+    char *text = NULL;
+    size_t len = 0;
+    tk_curve *input = NULL;
+    tk_vect_limits limits = TK_VECT_LIMITS_INIT;
+    limits.max_vertices = j->cfg.max_vertices;
+    int rc = tk_store_text(j->store, job->id, TK_TEXT_INPUT, &text, &len, err);
+    if (!rc && !text)
+        rc = tk_error_set(err, TK_EIO, "job %lld has no input", (long long)job->id);
+    if (!rc)
+        rc = tk_vect_parse(text, len, &limits, &input, err);
+    free(text);
+    if (!rc)
+        rc = tk_invariants_compute(input, &jr->input_type, err);
+    tk_curve_free(&input);
+    tk_error why;
+    if (!rc && tk_invariants_compare(&jr->input_type, tk_run_type_start(jr->run), &why))
+        rc = tk_error_set(err, TK_ETYPE, "the curve stored at step %ld, resumed, has another "
+                                         "knot or link type than the input: %s",
+                          job->latest.step, why.message);
+    return rc;
 }
 
 /* Sets up the engine run for a job: from its stored curve when it was
@@ -438,6 +488,8 @@ static int setup_run(tk_jobs *j, tk_job *job, job_run *jr, tk_error *err)
     if (!rc)
         rc = tk_run_new(curve, &opts, &jr->run, err);
     tk_curve_free(&curve);
+    if (!rc && resume)
+        rc = check_resumed_type(j, job, jr, err);
     return rc;
 }
 
@@ -458,12 +510,16 @@ static void run_job(worker_slot *slot)
     jr.hist.stride = 1;
     jr.frame_after = -1;
     if (!jr.hist.items) {
-        fail_job(j, &job, "out of memory");
+        fail_job(j, &job, "out of memory", NULL);
         return;
     }
     int rc = setup_run(j, &job, &jr, &err);
     if (rc) {
-        fail_job(j, &job, err.message);
+        char *type = jr.run ? invariants_text(&jr) : NULL;
+        fail_job(j, &job, err.message, type);
+        free(type);
+        tk_run_free(&jr.run);
+        tk_invariants_free(&jr.input_type);
         free(jr.hist.items);
         free(jr.pending_steps);
         free(jr.pending_xyz);
@@ -519,6 +575,7 @@ static void run_job(worker_slot *slot)
      * store still holds as running resumes at the next start. */
     store_job(&jr, &job, true);
     tk_run_free(&jr.run);
+    tk_invariants_free(&jr.input_type);
     free(jr.hist.items);
     free(jr.pending_steps);
     free(jr.pending_xyz);

@@ -76,7 +76,7 @@ static const char schema[] =
     " step_size REAL, rcond REAL, violation REAL, corrections INTEGER, vertices INTEGER,"
     " components INTEGER, fraction REAL, stop_reason TEXT, error TEXT,"
     " frames INTEGER NOT NULL DEFAULT 0,"
-    " input TEXT NOT NULL, curve TEXT, contacts TEXT, history TEXT);"
+    " input TEXT NOT NULL, curve TEXT, contacts TEXT, history TEXT, invariants TEXT);"
     "CREATE INDEX IF NOT EXISTS jobs_by_state ON jobs (state, id);"
     "CREATE TABLE IF NOT EXISTS frames ("
     " job INTEGER NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,"
@@ -91,6 +91,32 @@ static const char schema[] =
 static int db_error(tk_store *s, tk_error *err, const char *what)
 {
     return tk_error_set(err, TK_EIO, "job store: %s: %s", what, sqlite3_errmsg(s->db));
+}
+
+/* Columns added to the jobs table since its first version, each with its
+ * declaration: a store written before gets them, so that the daemon takes
+ * up the jobs an older one left. */
+static const char *const added_columns[][2] = {
+    {"invariants", "TEXT"},
+};
+
+static int add_columns(sqlite3 *db, char **message)
+{
+    for (size_t i = 0; i < sizeof added_columns / sizeof added_columns[0]; i++) {
+        char sql[160];
+        snprintf(sql, sizeof sql, "SELECT %s FROM jobs LIMIT 0", added_columns[i][0]);
+        sqlite3_stmt *st = NULL;
+        bool there = sqlite3_prepare_v2(db, sql, -1, &st, NULL) == SQLITE_OK;
+        sqlite3_finalize(st);
+        if (there)
+            continue;
+        snprintf(sql, sizeof sql, "ALTER TABLE jobs ADD COLUMN %s %s", added_columns[i][0],
+                 added_columns[i][1]);
+        int rc = sqlite3_exec(db, sql, NULL, NULL, message);
+        if (rc != SQLITE_OK)
+            return rc;
+    }
+    return SQLITE_OK;
 }
 
 int tk_store_open(const char *path, tk_store **out, tk_error *err)
@@ -120,6 +146,8 @@ int tk_store_open(const char *path, tk_store **out, tk_error *err)
                       NULL, NULL, &message);
     if (rc == SQLITE_OK)
         rc = sqlite3_exec(s->db, schema, NULL, NULL, &message);
+    if (rc == SQLITE_OK)
+        rc = add_columns(s->db, &message);
     if (rc != SQLITE_OK) {
         tk_error_set(err, TK_EIO, "cannot set up the job store %s: %s", path,
                      message ? message : sqlite3_errstr(rc));
@@ -397,6 +425,7 @@ static const char *text_column(tk_job_text which)
     case TK_TEXT_CURVE: return "curve";
     case TK_TEXT_CONTACTS: return "contacts";
     case TK_TEXT_HISTORY: return "history";
+    case TK_TEXT_INVARIANTS: return "invariants";
     default: return NULL;
     }
 }
@@ -437,8 +466,8 @@ static int add_frame_locked(tk_store *s, int64_t id, size_t seq, const tk_store_
 }
 
 int tk_store_save(tk_store *s, const tk_job *job, const char *curve, const char *contacts,
-                  const char *history, const tk_store_frame *frames, size_t nframes,
-                  tk_error *err)
+                  const char *history, const char *invariants, const tk_store_frame *frames,
+                  size_t nframes, tk_error *err)
 {
     pthread_mutex_lock(&s->lock);
     int status = TK_OK;
@@ -454,6 +483,8 @@ int tk_store_save(tk_store *s, const tk_job *job, const char *curve, const char 
         status = set_text_locked(s, job->id, TK_TEXT_CONTACTS, contacts, err);
     if (!status && history)
         status = set_text_locked(s, job->id, TK_TEXT_HISTORY, history, err);
+    if (!status && invariants)
+        status = set_text_locked(s, job->id, TK_TEXT_INVARIANTS, invariants, err);
     /* the frames are the last nframes of job->frames */
     for (size_t i = 0; !status && i < nframes; i++)
         status = add_frame_locked(s, job->id, job->frames - nframes + i, &frames[i], err);

@@ -1,9 +1,11 @@
 /* Tests for the SQLite job store (server/store.c): what is stored reads
  * back the same after closing and opening the file again, listing is
  * newest first with a filter and pages, frames come back bit for bit, and
- * the unfinished jobs are the queued and running ones, oldest first. */
+ * the unfinished jobs are the queued and running ones, oldest first; a
+ * store written before the invariants column gets it and keeps its jobs. */
 #include <check.h>
 #include <math.h>
+#include <sqlite3.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -92,7 +94,12 @@ START_TEST(a_job_reads_back_after_reopening)
             xyz[f][k] = sin(1.0 + f * 9 + k) / 3.0; /* not short decimals */
     tk_store_frame frames[2] = {{10, xyz[0], 9}, {20, xyz[1], 9}};
     j.frames = 2;
-    ck_assert_int_eq(tk_store_save(s, &j, "VECT curve", "{\"struts\":[]}", "[]", frames, 2, &err),
+    char *none = (char *)"not read";
+    ck_assert_int_eq(tk_store_text(s, id, TK_TEXT_INVARIANTS, &none, NULL, &err), TK_OK);
+    ck_assert_ptr_null(none); /* before the run starts */
+    const char *type = "{\"start\":{\"determinants\":[3]},\"result\":null}";
+    ck_assert_int_eq(tk_store_save(s, &j, "VECT curve", "{\"struts\":[]}", "[]", type, frames, 2,
+                                   &err),
                      TK_OK);
     tk_store_close(&s);
 
@@ -118,6 +125,9 @@ START_TEST(a_job_reads_back_after_reopening)
     free(text);
     ck_assert_int_eq(tk_store_text(s, id, TK_TEXT_INPUT, &text, NULL, &err), TK_OK);
     ck_assert(strncmp(text, "VECT\n1 3 0", 10) == 0);
+    free(text);
+    ck_assert_int_eq(tk_store_text(s, id, TK_TEXT_INVARIANTS, &text, NULL, &err), TK_OK);
+    ck_assert_str_eq(text, type);
     free(text);
     long *steps = NULL;
     double *coords = NULL;
@@ -212,6 +222,57 @@ START_TEST(an_unwritable_path_is_an_error)
 }
 END_TEST
 
+/* The jobs table as the first version of the store made it, with one
+ * finished job: opened by this one, the job reads back, has no type
+ * stored, and takes one. */
+START_TEST(an_older_store_gets_the_invariants_column)
+{
+    sqlite3 *db = NULL;
+    ck_assert_int_eq(sqlite3_open(path, &db), SQLITE_OK);
+    const char *old =
+        "CREATE TABLE jobs ("
+        " id INTEGER PRIMARY KEY AUTOINCREMENT,"
+        " name TEXT NOT NULL, state TEXT NOT NULL, options TEXT NOT NULL,"
+        " created REAL NOT NULL, started REAL, finished REAL,"
+        " has_figures INTEGER NOT NULL DEFAULT 0,"
+        " step INTEGER NOT NULL DEFAULT 0, seconds REAL, ropelength REAL, length REAL,"
+        " thickness REAL, minrad REAL, residual REAL, struts INTEGER, kinks INTEGER,"
+        " step_size REAL, rcond REAL, violation REAL, corrections INTEGER, vertices INTEGER,"
+        " components INTEGER, fraction REAL, stop_reason TEXT, error TEXT,"
+        " frames INTEGER NOT NULL DEFAULT 0,"
+        " input TEXT NOT NULL, curve TEXT, contacts TEXT, history TEXT);"
+        "INSERT INTO jobs (name, state, options, created, step, ropelength, input, curve)"
+        " VALUES ('old', 'done', '{\"steps\": 5}', 1.7e9, 5, 33.5, 'VECT in', 'VECT out');";
+    char *message = NULL;
+    ck_assert_msg(sqlite3_exec(db, old, NULL, NULL, &message) == SQLITE_OK, "%s", message);
+    sqlite3_close(db);
+
+    tk_store *s = open_store();
+    tk_job j;
+    tk_error err;
+    ck_assert_int_eq(tk_store_get(s, 1, &j, &err), TK_OK);
+    ck_assert_str_eq(j.name, "old");
+    ck_assert_int_eq(j.state, TK_JOB_DONE);
+    ck_assert_int_eq(j.latest.step, 5);
+    ck_assert(j.latest.ropelength == 33.5);
+    char *text = (char *)"not read";
+    ck_assert_int_eq(tk_store_text(s, 1, TK_TEXT_INVARIANTS, &text, NULL, &err), TK_OK);
+    ck_assert_ptr_null(text);
+    ck_assert_int_eq(tk_store_save(s, &j, NULL, NULL, NULL, "{\"start\":null}", NULL, 0, &err),
+                     TK_OK);
+    tk_store_close(&s);
+    /* opening it again adds nothing more */
+    s = open_store();
+    ck_assert_int_eq(tk_store_text(s, 1, TK_TEXT_INVARIANTS, &text, NULL, &err), TK_OK);
+    ck_assert_str_eq(text, "{\"start\":null}");
+    free(text);
+    ck_assert_int_eq(tk_store_text(s, 1, TK_TEXT_CURVE, &text, NULL, &err), TK_OK);
+    ck_assert_str_eq(text, "VECT out");
+    free(text);
+    tk_store_close(&s);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("store");
@@ -222,6 +283,7 @@ int main(void)
     tcase_add_test(tc, listing_is_newest_first_filtered_and_paged);
     tcase_add_test(tc, state_names_round_trip);
     tcase_add_test(tc, an_unwritable_path_is_an_error);
+    tcase_add_test(tc, an_older_store_gets_the_invariants_column);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);
 }

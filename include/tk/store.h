@@ -3,8 +3,8 @@
  * A job row holds what a client can ask for after a restart: the request
  * (name, options, input VECT), the state and timestamps, the latest
  * figures, the latest curve (so an unfinished job resumes from it), the
- * final contacts and the decimated history as JSON, and the snapshots
- * (frames) in their own table.
+ * final contacts, the decimated history and the knot or link type as
+ * JSON, and the snapshots (frames) in their own table.
  *
  * One store is shared by every thread of the daemon: each call takes the
  * store's lock for the duration of one statement or transaction.
@@ -57,12 +57,17 @@ typedef enum tk_job_text {
     TK_TEXT_INPUT = 0, /* the VECT as submitted */
     TK_TEXT_CURVE,     /* the latest curve as VECT (NULL before the run starts) */
     TK_TEXT_CONTACTS,  /* struts and kinks JSON (tk_json_contacts) */
-    TK_TEXT_HISTORY    /* decimated per-step figures, a JSON array */
+    TK_TEXT_HISTORY,   /* decimated per-step figures, a JSON array */
+    TK_TEXT_INVARIANTS /* {"start", "result"}: the knot or link type of the
+                          input and of the run's curve at its last check
+                          (tk_json_invariants each); NULL until the run
+                          has started */
 } tk_job_text;
 
 typedef struct tk_store tk_store;
 
-/* Opens (creating when missing) the database file and its tables. */
+/* Opens (creating when missing) the database file and its tables; a
+ * store written before a column was added gets it (NULL in its rows). */
 int tk_store_open(const char *path, tk_store **out, tk_error *err);
 void tk_store_close(tk_store **p);
 
@@ -82,7 +87,7 @@ int tk_store_list(tk_store *s, bool filter, tk_job_state state, size_t offset, s
 int tk_store_update(tk_store *s, const tk_job *job, tk_error *err);
 
 /* Stores the job (as tk_store_update) and, in the same transaction, any
- * non-NULL texts (curve, contacts, history) and frames. */
+ * non-NULL texts (curve, contacts, history, invariants) and frames. */
 typedef struct tk_store_frame {
     long step;
     const double *xyz;
@@ -90,8 +95,8 @@ typedef struct tk_store_frame {
 } tk_store_frame;
 
 int tk_store_save(tk_store *s, const tk_job *job, const char *curve, const char *contacts,
-                  const char *history, const tk_store_frame *frames, size_t nframes,
-                  tk_error *err);
+                  const char *history, const char *invariants, const tk_store_frame *frames,
+                  size_t nframes, tk_error *err);
 
 /* Reads one text; *out is NULL when it was never stored (free with free()). */
 int tk_store_text(tk_store *s, int64_t id, tk_job_text which, char **out, size_t *len,
