@@ -43,6 +43,35 @@ const sci = (v) => (v == null || !Number.isFinite(v) ? '–' : v === 0 ? '0' : M
 
 const compact = (n) => (n >= 1e6 && n % 1e5 === 0 ? `${n / 1e6}M` : n >= 1e4 && n % 100 === 0 ? `${n / 1e3}k` : `${n}`);
 
+// A knot or link type (the API's KnotType) in a few words: a knot's
+// Alexander polynomial and determinant, "1 - t + t^2 (det 3)"; a link's
+// linking numbers, its components' determinants and any knotted
+// component's polynomial, "lk 0-1: 1 (det 1 1)".  "?" for what is unknown.
+function typeText(k) {
+    if (!k) return '–';
+    const n = k.determinants.length;
+    const det = (i) => (k.determinants[i] == null ? '?' : `${k.determinants[i]}`);
+    if (n === 1) return k.alexander_text[0] == null ? '?' : `${k.alexander_text[0]} (det ${det(0)})`;
+    const pairs = [];
+    for (let a = 0; a < n; a++)
+        for (let b = a + 1; b < n; b++) pairs.push(`${a}-${b}: ${k.linking[a][b]}`);
+    const knotted = k.alexander_text.map((t, i) => (t != null && t !== '1' ? `; ${i}: ${t}` : '')).join('');
+    return `lk ${pairs.join(', ')} (det ${k.determinants.map((_, i) => det(i)).join(' ')})${knotted}`;
+}
+
+// The type figure: the result's, and the start's beside it when the run
+// changed it (the job has then failed).
+function showType(inv) {
+    const dd = $('fig-type');
+    const start = typeText(inv?.start);
+    const result = typeText(inv?.result);
+    const changed = inv != null && start !== result;
+    dd.textContent = changed ? `${start} → ${result}` : result;
+    dd.classList.toggle('changed', changed);
+    dd.title = inv == null ? 'not known before the run starts'
+        : changed ? `the start's type → the result's: ${start} → ${result}` : `start and result: ${result}`;
+}
+
 function fileName(job, ext) {
     const base = (job.name || 'job').replace(/[^A-Za-z0-9._-]+/g, '_');
     return `${base}-${job.id}${ext}`;
@@ -440,6 +469,7 @@ function showJob(job) {
     $('fig-kinks').textContent = job.kinks;
     $('fig-vertices').textContent = job.vertices;
     $('fig-seconds').textContent = job.seconds == null ? '–' : `${job.seconds.toFixed(1)} s`;
+    showType(job.invariants);
     const frac = job.progress.fraction ?? (job.state === 'done' ? 1 : 0);
     $('job-progress').style.width = `${(100 * frac).toFixed(1)}%`;
 }

@@ -143,6 +143,7 @@ test('Firefox: a catalogue knot submitted through the form is tightened and show
     assert.equal(await count('#contact-map .kink-mark'), contacts.kinks.length, 'one mark per kink');
     assert.equal(await text('#fig-struts'), String(job.struts));
     assert.equal(await text('#fig-ropelength'), job.ropelength.toFixed(3));
+    assert.equal(await text('#fig-type'), '1 - t + t^2 (det 3)', 'the trefoil\'s type');
     const d = await page.$eval('#chart path.curve', (p) => p.getAttribute('d'));
     assert.ok((d.match(/L/g) || []).length >= 2, 'the chart draws the history');
 

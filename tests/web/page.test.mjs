@@ -127,6 +127,9 @@ test('a catalogue knot submitted through the form is tightened and shown', async
     assert.equal(await page.locator('#fig-ropelength').innerText(), job.ropelength.toFixed(3));
     assert.equal(await page.locator('#fig-step').innerText(), String(job.progress.step));
     assert.equal(await page.locator('#fig-step-label').innerText(), 'step of 300');
+    // the type: the trefoil's, kept by the run
+    assert.deepEqual(job.invariants.result.alexander, [[1, -1, 1]]);
+    assert.equal(await page.locator('#fig-type').innerText(), '1 - t + t^2 (det 3)');
     const d = await page.locator('#chart path.curve').getAttribute('d');
     assert.ok((d.match(/L/g) || []).length >= 2, 'the chart draws the history');
 
@@ -286,6 +289,10 @@ test('a torus link generated in the page is thick enough and has its components'
     assert.equal(job.vertices, 120);
     assert.equal(job.name, 'T(2,4)');
     await page.waitForSelector('#job[data-phase="final"]');
+    // T(2,4): two unknots with linking number 2 (its sign by orientation)
+    const lk = job.invariants.result.linking[0][1];
+    assert.equal(Math.abs(lk), 2);
+    assert.equal(await page.locator('#fig-type').innerText(), `lk 0-1: ${lk} (det 1 1)`);
     const { body: contacts } = await api(`/v1/jobs/${id}/struts`);
     assert.equal(await page.locator('#contact-map .boundary').count(), 2, 'one boundary line each way');
     assert.equal(await page.locator('#contact-map .strut-mark').count(), contacts.struts.length);
