@@ -334,7 +334,8 @@ static int diagram(const tk_curve *c, size_t comp, unsigned long long seed, cros
                             "more than the %d its invariants are computed for",
                             comp, *count, TK_INVARIANT_MAX_CROSSINGS);
     }
-    qsort(*out, *count, sizeof **out, by_under);
+    if (*count > 1)
+        qsort(*out, *count, sizeof **out, by_under);
     return TK_OK;
 }
 

@@ -268,12 +268,16 @@ int tk_type_check(tk_run *r, const char *when, tk_error *err)
 }
 
 /* The figures of the best curve an escape found, put back when the run
- * stopped on another: its active set and forces, recorded as one more
- * entry of the history (step size 0). */
+ * stopped on another: its active set and forces replace the last step's
+ * entry of the history (same step number, step size 0), so the budget
+ * holds. */
 static int record_restored(tk_run *r, tk_error *err)
 {
     tk_step_report rep = {0};
-    rep.step = r->life.latest.step + 1;
+    rep.step = r->life.latest.step;
+    r->life.nhistory--;
+    if (r->life.nsnapshots > 0 && r->life.snapshot_steps[r->life.nsnapshots - 1] == rep.step)
+        r->life.nsnapshots--;
     tk_curve *c = r->shared.curve;
     tk_strut_finder_refit(r->shared.finder, c);
     int rc = tk_active_find(r, c, &r->active.set, err);
