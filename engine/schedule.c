@@ -294,7 +294,9 @@ int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_
     /* a deformed curve is thinner: scaled to the tube, as at the start */
     if (m.thickness < r->tau * (1.0 - tk_tolerance_overstep(r)))
         tk_curve_scale(curve, r->opt.autoscale_margin * r->tau / m.thickness);
-    rc = count != curve->nvert ? resample_to(r, count, err) : tk_schedule_fit(r, err);
+    /* resample_to checks the type of what it makes */
+    bool resampled = count != curve->nvert;
+    rc = resampled ? resample_to(r, count, err) : tk_schedule_fit(r, err);
     if (rc)
         return rc;
     r->schedule.polish_level = coarse ? 0 : polish;
@@ -302,7 +304,7 @@ int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_
     r->schedule.resampled_from = r->life.nhistory;
     r->schedule.resolved_at = r->life.latest.ropelength;
     tk_stepping_reset(r);
-    return tk_type_check(r, "an escape's deformation", err);
+    return resampled ? TK_OK : tk_type_check(r, "an escape's deformation", err);
 }
 
 /* Re-resolution during the run: the start was resampled to `resolution`

@@ -134,6 +134,19 @@ static int record(tk_run *r, tk_step_report *rep, tk_error *err)
     return TK_OK;
 }
 
+/* The rest of a step's figures, of the run's curve and its active set
+ * (found): the worst violation, the contacts and the kinks' report;
+ * then recorded. */
+static int figures(tk_run *r, tk_step_report *rep, tk_error *err)
+{
+    int rc = tk_recovery_violation(r, r->shared.curve, &rep->violation, err);
+    rep->struts = r->active.set.struts.count;
+    if (!rc)
+        rc = tk_active_report(r, err);
+    rep->kinks = r->active.nreport;
+    return rc ? rc : record(r, rep, err);
+}
+
 int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_error *err)
 {
     *out = NULL;
@@ -160,11 +173,12 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
         /* the start as given (tk_schedule_start validated it), before
          * resampling and scaling */
         double t0 = tk_clock();
-        rc = tk_invariants_compute(start, &r->type.start, err);
+        tk_error why;
+        rc = tk_invariants_compute(start, &r->type.start, &why);
         r->type.seconds += tk_clock() - t0;
         if (rc)
             tk_error_set(err, rc, "the knot or link type of the start cannot be told: %s",
-                         err ? err->message : "");
+                         why.message);
     }
     if (!rc && r->shared.curve->nvert != start->nvert) {
         char when[64];
@@ -179,14 +193,8 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
         rc = tk_recovery_correct(r, &rep.corrections, err);
     if (!rc)
         rc = tk_active_find(r, r->shared.curve, &r->active.set, err);
-    rep.struts = r->active.set.struts.count;
     if (!rc)
-        rc = tk_active_report(r, err);
-    rep.kinks = r->active.nreport;
-    if (!rc)
-        rc = tk_recovery_violation(r, r->shared.curve, &rep.violation, err);
-    if (!rc)
-        rc = record(r, &rep, err);
+        rc = figures(r, &rep, err);
     if (rc) {
         tk_run_free(&r);
         return rc;
@@ -284,13 +292,7 @@ static int record_restored(tk_run *r, tk_error *err)
     if (!rc)
         rc = tk_motion_resolve(r, &rep, false, err);
     if (!rc)
-        rc = tk_recovery_violation(r, c, &rep.violation, err);
-    rep.struts = r->active.set.struts.count;
-    if (!rc)
-        rc = tk_active_report(r, err);
-    rep.kinks = r->active.nreport;
-    if (!rc)
-        rc = record(r, &rep, err);
+        rc = figures(r, &rep, err);
     if (!rc && r->life.progress)
         (void)r->life.progress(&r->life.latest, r->life.user); /* stopping anyway */
     return rc;
@@ -357,13 +359,7 @@ static int step(tk_run *r, tk_error *err)
     if (!rc && worst > 0.5 * tk_tolerance_overstep(r))
         rc = tk_recovery_correct(r, &rep.corrections, err);
     if (!rc)
-        rc = tk_recovery_violation(r, c, &rep.violation, err);
-    rep.struts = r->active.set.struts.count;
-    if (!rc)
-        rc = tk_active_report(r, err);
-    rep.kinks = r->active.nreport;
-    if (!rc)
-        rc = record(r, &rep, err);
+        rc = figures(r, &rep, err);
     if (rc) {
         r->life.stop = TK_STOP_FAILED;
         return rc;
