@@ -16,6 +16,31 @@ void tk_constraints_free(tk_constraints *set)
     *set = (tk_constraints){0};
 }
 
+/* *dst becomes a copy of src (its old contents freed). */
+int tk_constraints_copy(tk_constraints *dst, const tk_constraints *src, tk_error *err)
+{
+    tk_constraints_free(dst);
+    size_t ns = src->struts.count, nk = src->nkinks;
+    dst->struts.items = malloc((ns ? ns : 1) * sizeof *dst->struts.items);
+    dst->kinks = malloc((nk ? nk : 1) * sizeof *dst->kinks);
+    dst->kink_edge = malloc(nk ? nk : 1);
+    if (!dst->struts.items || !dst->kinks || !dst->kink_edge) {
+        tk_constraints_free(dst);
+        return tk_error_set(err, TK_ENOMEM, "out of memory copying an active set");
+    }
+    if (ns)
+        memcpy(dst->struts.items, src->struts.items, ns * sizeof *dst->struts.items);
+    if (nk) {
+        memcpy(dst->kinks, src->kinks, nk * sizeof *dst->kinks);
+        memcpy(dst->kink_edge, src->kink_edge, nk);
+    }
+    dst->struts.capacity = ns ? ns : 1;
+    dst->struts.count = ns;
+    dst->nkinks = nk;
+    dst->kink_capacity = nk ? nk : 1;
+    return TK_OK;
+}
+
 void tk_active_free(tk_run *r)
 {
     tk_constraints_free(&r->active.set);

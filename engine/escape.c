@@ -46,6 +46,7 @@
 void tk_escape_free(tk_run *r)
 {
     tk_curve_free(&r->escape.best);
+    tk_constraints_free(&r->escape.best_set);
     free(r->escape.log);
 }
 
@@ -79,6 +80,8 @@ static int note(tk_run *r, tk_error *err)
         return TK_OK;
     tk_curve_free(&r->escape.best);
     int rc = tk_curve_copy(r->shared.curve, &r->escape.best, err);
+    if (!rc)
+        rc = tk_constraints_copy(&r->escape.best_set, &r->active.set, err);
     r->escape.best_report = *s;
     r->escape.best_polish = r->schedule.polish_level;
     return rc;

@@ -129,6 +129,10 @@ struct tk_run {
         uint64_t rng;        /* the deformations' random stream */
         tk_curve *best;      /* the best final polygon so far, or NULL */
         tk_step_report best_report;
+        tk_constraints best_set; /* the active set of its step: found
+                                    again at the curve alone it can lack a
+                                    contact the step held (a kink just
+                                    outside the tolerance) */
         int best_polish;     /* its polishing level */
         bool due;            /* deform before the next step */
         tk_escape *log;      /* one per try */
@@ -216,6 +220,7 @@ int tk_active_report(tk_run *r, tk_error *err);
 void tk_active_reset(tk_run *r);
 void tk_active_free(tk_run *r);
 void tk_constraints_free(tk_constraints *set);
+int tk_constraints_copy(tk_constraints *dst, const tk_constraints *src, tk_error *err);
 double tk_branch_radius(const tk_curve *c, size_t v, int edge);
 
 /* ---- motion.c ---- */

@@ -288,7 +288,7 @@ static int record_restored(tk_run *r, tk_error *err)
         r->life.nsnapshots--;
     tk_curve *c = r->shared.curve;
     tk_strut_finder_refit(r->shared.finder, c);
-    int rc = tk_active_find(r, c, &r->active.set, err);
+    int rc = tk_constraints_copy(&r->active.set, &r->escape.best_set, err);
     if (!rc)
         rc = tk_motion_resolve(r, &rep, false, err);
     if (!rc)

@@ -120,6 +120,11 @@ static void history_add(history *h, const tk_step_report *r)
 {
     if (r->step % h->stride != 0)
         return;
+    /* the engine reports a step again when it puts its best curve back */
+    if (h->count > 0 && h->items[h->count - 1].step == r->step) {
+        h->items[h->count - 1] = *r;
+        return;
+    }
     if (h->count == h->cap) {
         /* keep every other entry: the history stays evenly spaced */
         size_t kept = 0;
@@ -203,6 +208,7 @@ typedef struct job_run {
                                this step (the resume step: its frame, if
                                due, was stored with it) */
     size_t per_frame;       /* doubles per frame */
+    long last_step;         /* the last step reported (-1: none yet) */
     long *pending_steps;    /* frames taken since the last write */
     double *pending_xyz;
     size_t pending, pending_cap;
@@ -237,9 +243,21 @@ static size_t job_frames(const job_run *jr)
  * The worker takes the frames itself (the engine's snapshots stay off):
  * they stay on the grid of the job's steps across a resume, and a long
  * run holds only the frames since the last write. */
-static void take_frame(job_run *jr, long every, long step)
+static void take_frame(job_run *jr, long every, long step, bool again)
 {
-    if (every <= 0 || step <= jr->frame_after || step % every != 0)
+    if (every <= 0 || step % every != 0)
+        return;
+    if (again && step == jr->frame_after && job_frames(jr) > 0) {
+        /* the step reported again (the run's best curve put back): its
+         * frame is taken again in its place, stored or not (frames are
+         * written by their place in the job's sequence) */
+        if (jr->pending > 0)
+            jr->pending--;
+        else
+            jr->frames_stored--;
+        jr->frame_after = step - 1;
+    }
+    if (step <= jr->frame_after)
         return;
     const tk_curve *c = tk_run_curve(jr->run);
     size_t per = 3 * c->nvert;
@@ -380,9 +398,11 @@ static int on_step(const tk_step_report *s, void *user)
     tk_step_report r = *s;
     r.step += jr->step_offset;
     r.seconds += jr->seconds_offset;
+    bool again = r.step == jr->last_step;
+    jr->last_step = r.step;
     history_add(&jr->hist, &r);
-    take_frame(jr, slot->job.options.every, r.step);
-    if (s->step > 0)
+    take_frame(jr, slot->job.options.every, r.step, again);
+    if (s->step > 0 && !again)
         atomic_fetch_add(&j->steps_total, 1);
     pthread_mutex_lock(&j->lock);
     slot->job.latest = r;
@@ -509,6 +529,7 @@ static void run_job(worker_slot *slot)
     jr.hist.items = malloc(jr.hist.cap * sizeof *jr.hist.items);
     jr.hist.stride = 1;
     jr.frame_after = -1;
+    jr.last_step = -1;
     if (!jr.hist.items) {
         fail_job(j, &job, "out of memory", NULL);
         return;

@@ -8,7 +8,8 @@
 #include <string.h>
 
 const char *const tk_job_option_names[] = {"resolution", "steps", "time", "residual",
-                                           "radius", "lambda", "autoscale", "every", NULL};
+                                           "radius", "lambda", "autoscale", "every",
+                                           "escapes", "seed", NULL};
 
 /* Largest step count and interval we accept: a run of 10^9 steps is
  * already years of work, and the bound keeps every value exact in a
@@ -17,6 +18,8 @@ const char *const tk_job_option_names[] = {"resolution", "steps", "time", "resid
 /* Above this many vertices per unit ropelength the run would not fit in
  * memory for any real knot; the service also caps the vertex count. */
 #define MAX_RESOLUTION 10000.0
+/* The engine's bound on escape tries (tk_options.escapes). */
+#define MAX_ESCAPES 1000L
 /* A week: a job longer than that should be resumed as a new one. */
 #define MAX_TIME 604800.0
 
@@ -24,7 +27,8 @@ typedef enum { KIND_REAL, KIND_COUNT, KIND_FLAG } option_kind;
 
 static option_kind kind_of(const char *name)
 {
-    if (!strcmp(name, "steps") || !strcmp(name, "every"))
+    if (!strcmp(name, "steps") || !strcmp(name, "every") || !strcmp(name, "escapes") ||
+        !strcmp(name, "seed"))
         return KIND_COUNT;
     if (!strcmp(name, "autoscale"))
         return KIND_FLAG;
@@ -80,13 +84,18 @@ static int set_real(tk_job_options *o, const char *name, double x, tk_error *err
 
 static int set_count(tk_job_options *o, const char *name, long long n, tk_error *err)
 {
-    if (n < 0 || n > MAX_COUNT)
+    long most = !strcmp(name, "escapes") ? MAX_ESCAPES : MAX_COUNT;
+    if (n < 0 || n > most)
         return tk_error_set(err, TK_EINVAL, "option '%s': must be a whole number from 0 to %ld",
-                            name, MAX_COUNT);
+                            name, most);
     if (!strcmp(name, "steps"))
         o->steps = (long)n;
-    else
+    else if (!strcmp(name, "every"))
         o->every = (long)n;
+    else if (!strcmp(name, "escapes"))
+        o->escapes = (long)n;
+    else
+        o->seed = (long)n;
     return TK_OK;
 }
 
@@ -177,10 +186,11 @@ int tk_job_options_from_json(tk_job_options *o, const json_t *obj, const char **
 
 json_t *tk_job_options_to_json(const tk_job_options *o)
 {
-    return json_pack("{s:f, s:I, s:f, s:f, s:f, s:f, s:b, s:I}", "resolution", o->resolution,
-                     "steps", (json_int_t)o->steps, "time", o->time, "residual", o->residual,
-                     "radius", o->radius, "lambda", o->lambda, "autoscale", o->autoscale,
-                     "every", (json_int_t)o->every);
+    return json_pack("{s:f, s:I, s:f, s:f, s:f, s:f, s:b, s:I, s:I, s:I}", "resolution",
+                     o->resolution, "steps", (json_int_t)o->steps, "time", o->time, "residual",
+                     o->residual, "radius", o->radius, "lambda", o->lambda, "autoscale",
+                     o->autoscale, "every", (json_int_t)o->every, "escapes",
+                     (json_int_t)o->escapes, "seed", (json_int_t)o->seed);
 }
 
 void tk_job_options_to_run(const tk_job_options *o, tk_options *run)
@@ -195,6 +205,8 @@ void tk_job_options_to_run(const tk_job_options *o, tk_options *run)
     run->lambda = o->lambda;
     run->autoscale = o->autoscale;
     run->snapshot_every = (size_t)o->every;
+    run->escapes = (int)o->escapes;
+    run->seed = (unsigned long long)o->seed;
     if (o->steps == 0 && o->time == 0.0 && o->residual == 0.0)
         run->max_steps = TK_JOB_DEFAULT_STEPS;
 }

@@ -14,12 +14,14 @@ START_TEST(every_option_is_set_from_text)
     tk_error err;
     const char *pairs[][2] = {{"resolution", "7.5"}, {"steps", "120"}, {"time", "2.5"},
                               {"residual", "1e-3"},  {"radius", "0.75"}, {"lambda", "1.5"},
-                              {"autoscale", "true"}, {"every", "10"}};
-    for (size_t i = 0; i < 8; i++)
+                              {"autoscale", "true"}, {"every", "10"},   {"escapes", "3"},
+                              {"seed", "42"}};
+    for (size_t i = 0; i < 10; i++)
         ck_assert_msg(tk_job_option_set_text(&o, pairs[i][0], pairs[i][1], &err) == TK_OK, "%s",
                       err.message);
     ck_assert(o.resolution == 7.5 && o.steps == 120 && o.time == 2.5 && o.residual == 1e-3);
     ck_assert(o.radius == 0.75 && o.lambda == 1.5 && o.autoscale && o.every == 10);
+    ck_assert(o.escapes == 3 && o.seed == 42);
     ck_assert_int_eq(tk_job_option_set_text(&o, "autoscale", "0", &err), TK_OK);
     ck_assert(!o.autoscale);
 }
@@ -31,7 +33,7 @@ START_TEST(bad_values_name_the_option)
                             {"resolution", "-2"}, {"resolution", "1e9"},  {"steps", "1.5"},
                             {"steps", "-3"},      {"steps", "99999999999"}, {"time", "x"},
                             {"residual", "inf"},  {"autoscale", "maybe"}, {"every", ""},
-                            {"radius", "1 2"}};
+                            {"radius", "1 2"},     {"escapes", "1001"},  {"seed", "-1"}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         tk_job_options o = TK_JOB_OPTIONS_INIT;
         tk_job_options before = o;
@@ -51,9 +53,9 @@ END_TEST
 START_TEST(json_options_round_trip)
 {
     tk_job_options o = TK_JOB_OPTIONS_INIT;
-    json_t *in = json_pack("{s:f, s:i, s:f, s:f, s:f, s:f, s:b, s:i}", "resolution", 5.0,
-                           "steps", 300, "time", 0.0, "residual", 0.01, "radius", 0.5, "lambda",
-                           2.0, "autoscale", 1, "every", 25);
+    json_t *in = json_pack("{s:f, s:i, s:f, s:f, s:f, s:f, s:b, s:i, s:i, s:i}", "resolution",
+                           5.0, "steps", 300, "time", 0.0, "residual", 0.01, "radius", 0.5,
+                           "lambda", 2.0, "autoscale", 1, "every", 25, "escapes", 0, "seed", 7);
     tk_error err;
     ck_assert_int_eq(tk_job_options_from_json(&o, in, NULL, &err), TK_OK);
     json_t *out = tk_job_options_to_json(&o);

@@ -52,8 +52,8 @@ const char tk_remote_help[] =
     "\n"
     "Run options (as for tightknot tighten): --resolution R, --steps N,\n"
     "--time SECONDS, --residual X, --radius R, --lambda L, --autoscale,\n"
-    "--every K (keep a frame every K steps).  With none of steps, time and\n"
-    "residual a job stops after 1000 steps.\n"
+    "--every K (keep a frame every K steps), --escapes N, --seed S.  With\n"
+    "none of steps, time and residual a job stops after 1000 steps.\n"
     "\n"
     "Options:\n"
     "  --server URL   the service (default $TIGHTKNOT_SERVER, else\n"
@@ -939,6 +939,8 @@ int tk_remote_main(int argc, char **argv)
     QUERY(opts.lambda != defaults.lambda, "&lambda=%.17g", opts.lambda);
     QUERY(opts.autoscale, "&autoscale=true");
     QUERY(opts.every != defaults.every, "&every=%ld", opts.every);
+    QUERY(opts.escapes != defaults.escapes, "&escapes=%ld", opts.escapes);
+    QUERY(opts.seed != defaults.seed, "&seed=%ld", opts.seed);
 #undef QUERY
 
     client c;

@@ -1,6 +1,6 @@
 /* tightknot: the run options of a tightening job, by name.
  *
- * The same eight options reach a run from the command line (--resolution
+ * The same ten options reach a run from the command line (--resolution
  * 5), from an HTTP query (?resolution=5) and from a JSON object
  * ({"resolution": 5}); this module is the one place that knows their names,
  * their domains and their defaults, so every way in says the same thing
@@ -26,9 +26,11 @@ typedef struct tk_job_options {
     double lambda;     /* stiffness: minrad >= lambda * radius */
     bool autoscale;    /* scale the start so no contact is active */
     long every;        /* keep a snapshot every this many steps (0: none) */
+    long escapes;      /* most escape tries (tk_options.escapes) */
+    long seed;         /* of the escapes' deformations */
 } tk_job_options;
 
-#define TK_JOB_OPTIONS_INIT {0.0, 0, 0.0, 0.0, 0.5, 1.0, false, 0}
+#define TK_JOB_OPTIONS_INIT {0.0, 0, 0.0, 0.0, 0.5, 1.0, false, 0, 8, 1}
 
 /* With no stop criterion given, a run stops after this many steps. */
 #define TK_JOB_DEFAULT_STEPS 1000
@@ -50,7 +52,7 @@ int tk_job_option_set_text(tk_job_options *o, const char *name, const char *text
 int tk_job_options_from_json(tk_job_options *o, const json_t *obj, const char **bad,
                              tk_error *err);
 
-/* A JSON object with all eight options. */
+/* A JSON object with all ten options. */
 json_t *tk_job_options_to_json(const tk_job_options *o);
 
 /* The engine's options for the job, with the default step limit applied
