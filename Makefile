@@ -40,7 +40,7 @@ endif
 CHECK_CFLAGS := $(shell pkg-config --cflags check 2>/dev/null)
 CHECK_LIBS := $(shell pkg-config --libs check 2>/dev/null)
 
-CPPFLAGS += -Iinclude -Itests/support -I/usr/include/suitesparse -D_XOPEN_SOURCE=700
+CPPFLAGS += -Iinclude -Icommon -Itests/support -I/usr/include/suitesparse -D_XOPEN_SOURCE=700
 CFLAGS += -std=c11 $(OPT) -g -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
 	-Wmissing-prototypes -Wno-missing-field-initializers -MMD -MP $(SAN_FLAGS)
 LDFLAGS += $(SAN_FLAGS)
@@ -55,6 +55,11 @@ endif
 ENGINE_SRC := $(wildcard engine/*.c)
 ENGINE_OBJ := $(ENGINE_SRC:%.c=$(BUILD)/%.o)
 LIB := $(BUILD)/libtightknot.a
+
+# What the command line and the service share: the records' JSON.
+COMMON_SRC := $(wildcard common/*.c)
+COMMON_OBJ := $(COMMON_SRC:%.c=$(BUILD)/%.o)
+COMMON_LIB := $(BUILD)/libtkcommon.a
 
 SERVER_SRC := $(filter-out server/tightknotd.c,$(wildcard server/*.c))
 SERVER_OBJ := $(SERVER_SRC:%.c=$(BUILD)/%.o)
@@ -122,32 +127,38 @@ $(SERVER_LIB): $(SERVER_OBJ)
 	@$(if $(Q),echo "  AR      $@")
 	$(Q)rm -f $@ && ar rcs $@ $^
 
-$(CLI): $(CLI_OBJ) $(SERVER_LIB) $(LIB)
-	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(SERVER_LIB) $(LIB) $(SERVER_LIBS) -lcurl $(LDLIBS)
+$(COMMON_LIB): $(COMMON_OBJ)
+	@$(if $(Q),echo "  AR      $@")
+	$(Q)rm -f $@ && ar rcs $@ $^
 
-$(DAEMON): $(BUILD)/server/tightknotd.o $(SERVER_LIB) $(LIB)
+# The command line shares only the records' JSON with the service: neither
+# libmicrohttpd nor SQLite on its link line.
+$(CLI): $(CLI_OBJ) $(COMMON_LIB) $(LIB)
 	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(SERVER_LIB) $(LIB) $(SERVER_LIBS) $(LDLIBS)
+	$(Q)$(CC) $(LDFLAGS) -o $@ $(CLI_OBJ) $(COMMON_LIB) $(LIB) -ljansson -lcurl $(LDLIBS)
 
-$(BUILD)/tests/%: $(BUILD)/tests/%.o $(TEST_SUPPORT_OBJ) $(SERVER_LIB) $(LIB)
+$(DAEMON): $(BUILD)/server/tightknotd.o $(SERVER_LIB) $(COMMON_LIB) $(LIB)
 	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(SERVER_LIB) $(LIB) $(CHECK_LIBS) \
+	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(SERVER_LIB) $(COMMON_LIB) $(LIB) $(SERVER_LIBS) $(LDLIBS)
+
+$(BUILD)/tests/%: $(BUILD)/tests/%.o $(TEST_SUPPORT_OBJ) $(SERVER_LIB) $(COMMON_LIB) $(LIB)
+	@$(if $(Q),echo "  LD      $@")
+	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(SERVER_LIB) $(COMMON_LIB) $(LIB) $(CHECK_LIBS) \
 		$(SERVER_LIBS) $(LDLIBS)
 
 # The fuzz targets see the service's own headers too (server/submission.h).
 $(BUILD)/tests/fuzz/%.o: CPPFLAGS += -Iserver
 
-$(BUILD)/fuzz/replay_%: $(BUILD)/tests/fuzz/fuzz_%.o $(BUILD)/tests/fuzz/replay.o $(SERVER_LIB) $(LIB)
+$(BUILD)/fuzz/replay_%: $(BUILD)/tests/fuzz/fuzz_%.o $(BUILD)/tests/fuzz/replay.o $(SERVER_LIB) $(COMMON_LIB) $(LIB)
 	@mkdir -p $(dir $@)
 	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(BUILD)/tests/fuzz/replay.o $(SERVER_LIB) $(LIB) \
+	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(BUILD)/tests/fuzz/replay.o $(SERVER_LIB) $(COMMON_LIB) $(LIB) \
 		$(SERVER_LIBS) $(LDLIBS)
 
-$(BUILD)/fuzz/fuzz_%: $(BUILD)/tests/fuzz/fuzz_%.o $(SERVER_LIB) $(LIB)
+$(BUILD)/fuzz/fuzz_%: $(BUILD)/tests/fuzz/fuzz_%.o $(SERVER_LIB) $(COMMON_LIB) $(LIB)
 	@mkdir -p $(dir $@)
 	@$(if $(Q),echo "  LD      $@")
-	$(Q)$(CC) $(LDFLAGS) -fsanitize=fuzzer -o $@ $< $(SERVER_LIB) $(LIB) $(SERVER_LIBS) $(LDLIBS)
+	$(Q)$(CC) $(LDFLAGS) -fsanitize=fuzzer -o $@ $< $(SERVER_LIB) $(COMMON_LIB) $(LIB) $(SERVER_LIBS) $(LDLIBS)
 
 $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIB)
 	@$(if $(Q),echo "  LD      $@")
@@ -202,17 +213,17 @@ bench-service: deps all
 # Banned unsafe calls (curl's list).
 lint:
 	$(Q)! grep -nE '\b(sprintf|strcpy|strcat|atoi|atof|gets)\s*\(' \
-		engine/*.c server/*.c tools/*.c tests/*.c bench/*.c 2>/dev/null || \
+		engine/*.c common/*.c server/*.c tools/*.c tests/*.c bench/*.c 2>/dev/null || \
 		(echo "lint: banned call found" && false)
 
 # Each public header compiles on its own.
 headers:
-	$(Q)for h in include/tk/*.h; do \
+	$(Q)for h in include/tk/*.h common/*.h; do \
 		echo "#include \"$${h#include/}\"" | $(CC) $(CPPFLAGS) -std=c11 -Wall -Wextra -Werror \
 			-fsyntax-only -x c - || exit 1; done
 
 clean:
 	rm -rf build
 
--include $(ENGINE_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(BUILD)/server/tightknotd.d $(CLI_OBJ:.o=.d) $(TEST_BIN:%=%.d) $(TEST_SUPPORT_OBJ:.o=.d) \
+-include $(ENGINE_OBJ:.o=.d) $(COMMON_OBJ:.o=.d) $(SERVER_OBJ:.o=.d) $(BUILD)/server/tightknotd.d $(CLI_OBJ:.o=.d) $(TEST_BIN:%=%.d) $(TEST_SUPPORT_OBJ:.o=.d) \
 	$(BENCH_BIN:%=%.d) $(FUZZ_TARGETS:%=$(BUILD)/tests/fuzz/fuzz_%.d) $(BUILD)/tests/fuzz/replay.d

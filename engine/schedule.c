@@ -59,7 +59,7 @@ double tk_tolerance_overstep(const tk_run *r)
 
 double tk_tolerance_correction(const tk_run *r)
 {
-    return fmin(r->opt.correction_tolerance, 0.1 * tk_tolerance_overstep(r));
+    return 0.1 * tk_tolerance_overstep(r);
 }
 
 /* The thickness of the starting curve, for set-up. */

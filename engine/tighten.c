@@ -7,6 +7,7 @@
 #include <time.h>
 
 #include "run.h"
+#include "tk/record.h"
 #include "tk/thickness.h"
 
 double tk_clock(void)
@@ -29,43 +30,6 @@ const char *tk_stop_reason_name(tk_stop_reason r)
     case TK_STOP_FAILED: return "failed";
     }
     return "unknown";
-}
-
-static int check_options(const tk_options *o, tk_error *err)
-{
-    if (!(o->radius >= TK_CURVE_EDGE_MIN && o->radius <= TK_CURVE_COORD_MAX))
-        return tk_error_set(err, TK_EINVAL, "radius must be between %g and %g (got %g)",
-                            TK_CURVE_EDGE_MIN, TK_CURVE_COORD_MAX, o->radius);
-    if (!(o->lambda > 0.0) || !isfinite(o->lambda))
-        return tk_error_set(err, TK_EINVAL, "lambda must be a positive number (got %g)", o->lambda);
-    if (!(o->resolution >= 0.0) || o->resolution > 1e4)
-        return tk_error_set(err, TK_EINVAL, "resolution must be between 0 and 10000 (got %g)",
-                            o->resolution);
-    if (o->autoscale && !(o->autoscale_margin >= 1.0 && o->autoscale_margin < 2.0))
-        return tk_error_set(err, TK_EINVAL, "autoscale margin must be in [1, 2) (got %g)",
-                            o->autoscale_margin);
-    if (o->max_steps < 0 || !(o->max_seconds >= 0.0) || !(o->min_residual >= 0.0) ||
-        !(o->min_change >= 0.0))
-        return tk_error_set(err, TK_EINVAL, "stop criteria must not be negative");
-    if (!(o->active_tolerance > 0.0 && o->active_tolerance < 0.5) ||
-        !(o->overstep_tolerance > 0.0 && o->overstep_tolerance < 0.1) ||
-        !(o->correction_tolerance > 0.0 && o->correction_tolerance < o->overstep_tolerance))
-        return tk_error_set(err, TK_EINVAL,
-                            "tolerances must satisfy 0 < correction < overstep < 0.1 and "
-                            "0 < active < 0.5");
-    if (!(o->equalise >= 0.0) || !isfinite(o->equalise))
-        return tk_error_set(err, TK_EINVAL, "equalise gain must be >= 0");
-    if (o->escapes < 0 || o->escapes > 1000)
-        return tk_error_set(err, TK_EINVAL, "escapes must be between 0 and 1000 (got %d)",
-                            o->escapes);
-    if (!(o->re_resolve >= 0.0 && o->re_resolve < 1.0))
-        return tk_error_set(err, TK_EINVAL, "re_resolve must be in [0, 1) (got %g)",
-                            o->re_resolve);
-    if (o->re_resolve > 0.0 && o->snapshot_every > 0)
-        return tk_error_set(err, TK_EINVAL,
-                            "re_resolve changes the vertex count, which snapshots keep: "
-                            "use one or the other");
-    return TK_OK;
 }
 
 void tk_run_free(tk_run **p)
@@ -153,7 +117,7 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
     tk_options defaults = TK_OPTIONS_INIT;
     if (!opts)
         opts = &defaults;
-    int rc = check_options(opts, err);
+    int rc = tk_options_check(opts, err);
     if (rc)
         return rc;
     tk_run *r = calloc(1, sizeof *r);

@@ -22,7 +22,7 @@
 #include <microhttpd.h>
 
 #include "tk/jobspec.h"
-#include "tk/jsonmap.h"
+#include "jsonmap.h"
 #include "tk/vect.h"
 
 #include "submission.h"

@@ -13,7 +13,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "tk/jsonmap.h"
+#include "jsonmap.h"
 #include "tk/vect.h"
 
 /* What a worker is doing, visible to the request handlers. */

@@ -11,7 +11,7 @@
 #include <jansson.h>
 #include <sqlite3.h>
 
-#include "tk/jsonmap.h"
+#include "jsonmap.h"
 
 /* Below this much free space health calls the store full: a job's save
  * (its curve and frames) needs room beyond a page or two. */

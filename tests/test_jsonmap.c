@@ -11,7 +11,7 @@
 
 #include "support.h"
 #include "tk/generate.h"
-#include "tk/jsonmap.h"
+#include "jsonmap.h"
 #include "tk/thickness.h"
 
 /* The point at arclength a along the curve's components laid end to end,

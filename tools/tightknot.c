@@ -16,7 +16,9 @@
  * Exit status: 0 success, 1 usage error (the message names the option or
  * argument), 2 bad input (the engine's message, "FILE:LINE: what").
  */
+#include <ctype.h>
 #include <errno.h>
+#include <getopt.h>
 #include <jansson.h>
 #include <limits.h>
 #include <math.h>
@@ -31,8 +33,8 @@
 #include "tk/error.h"
 #include "tk/generate.h"
 #include "tk/invariants.h"
-#include "tk/jobspec.h"
-#include "tk/jsonmap.h"
+#include "tk/record.h"
+#include "jsonmap.h"
 #include "tk/struts.h"
 #include "tk/thickness.h"
 #include "tk/tighten.h"
@@ -199,55 +201,29 @@ static const char tighten_help[] =
     "the given radius around it stays embedded (struts and kinks are the\n"
     "active constraints, resolved by non-negative least squares).\n"
     "\n"
-    "Run options:\n"
-    "  --radius R        tube radius (default 0.5, so the diameter is 1)\n"
-    "  --lambda L        stiffness: minrad >= L * radius (default 1)\n"
-    "  --resolution R    first resample to R vertices per unit ropelength\n"
-    "                    (5 quick, 10 medium, 20 fine; default: keep the\n"
-    "                    input's vertices)\n"
-    "  --autoscale       first scale the curve so its thickness is just above\n"
-    "                    the diameter (needed when the input is thinner)\n"
-    "  --overstep EPS    largest constraint violation a step may make, as a\n"
-    "                    fraction of the diameter (default 1e-5; violations\n"
-    "                    are corrected down to EPS / 10)\n"
-    "  --re-resolve F    with --resolution: each time the ropelength has fallen\n"
-    "                    by the fraction F, resample to resolution * ropelength\n"
-    "                    vertices again, keeping the resolution as the knot\n"
-    "                    tightens (e.g. 0.05; default 0: never)\n"
-    "  --no-coarse       with --resolution: start at that resolution; by\n"
-    "                    default the run starts with half the vertices (a\n"
-    "                    quarter, ... while 2.5 per unit ropelength remain)\n"
-    "                    and doubles them whenever the ropelength all but\n"
-    "                    stops falling, which gets past slow stretches of\n"
-    "                    the flow many times faster\n"
-    "  --escapes N       each time the ropelength all but stops falling on\n"
-    "                    the final polygon, while budget is left: deform\n"
-    "                    the best curve so far at random, tighten it again\n"
-    "                    and keep the better, at most N times (default 8;\n"
-    "                    0: off).  Gets symmetric or contorted starts out of\n"
-    "                    configurations that are critical but not tight;\n"
-    "                    the result is always the best curve found\n"
-    "  --seed S          of the escapes' deformations (default 1): the same\n"
-    "                    seed, the same run\n"
-    "Stop criteria (the first met stops the run; default --steps 1000):\n"
-    "  --steps N         after N steps\n"
-    "  --time SECONDS    after this much wall time\n"
-    "  --residual X      when the residual (|resolved gradient| / |gradient|)\n"
-    "                    falls below X\n"
+    "Run options (the service's job options, by the same names):\n";
+
+static const char tighten_help_end[] =
+    "\n"
+    "With none of --steps, --time and --residual the run stops after 1000\n"
+    "steps; otherwise at the first criterion met.\n"
+    "\n"
     "Outputs:\n"
     "  -o, --output OUT.vect   the tightened curve (VECT)\n"
     "  --struts OUT.json       the final struts and kinks with their forces\n"
     "  --log OUT.tsv           one line of figures per step\n"
     "  --snapshots DIR         write DIR/step-NNNNNN.vect every K steps\n"
     "  --every K               snapshot interval (default 100)\n"
-    "  --json                  print one JSON object with the final figures:\n"
-    "                          ropelength, length, thickness, minrad, vertices,\n"
-    "                          components, steps, seconds, residual, struts,\n"
-    "                          kinks, stop_reason, invariants: {start,\n"
-    "                          result}, the knot or link type of the input and\n"
-    "                          of the result, as in 'tightknot info --json',\n"
-    "                          and escapes: [{step, from, amplitude, reached,\n"
-    "                          improved}], one per escape tried\n"
+    "  --json                  print one JSON object: the file, the last\n"
+    "                          step's figures (the columns of --log: step,\n"
+    "                          seconds, ropelength, length, thickness, minrad,\n"
+    "                          residual, struts, kinks, ...), components,\n"
+    "                          steps, stop_reason, options (the run options as\n"
+    "                          used), invariants: {start, result}, the knot or\n"
+    "                          link type of the input and of the result, as in\n"
+    "                          'tightknot info --json', and escapes: [{step,\n"
+    "                          from, amplitude, reached, improved}], one per\n"
+    "                          escape tried\n"
     "  -h, --help              show this help\n"
     "\n"
     "A progress line goes to standard error when it is a terminal.  The\n"
@@ -267,63 +243,44 @@ static const char tighten_help[] =
 
 /* -------------------------------------------------------- option parsing */
 
+/* The subcommands, as bits: which take which option. */
+enum { CMD_INFO = 1u, CMD_STRUTS = 2u, CMD_GENERATE = 4u, CMD_TIGHTEN = 8u };
+
+/* The command line's own options; tighten also takes every named run
+ * option (tk/record.h), as --name with '_' written '-', a BOOL as --name
+ * and --no-name. */
 enum {
-    OPT_JSON = 1u << 0,
-    OPT_TOLERANCE = 1u << 1,
-    OPT_VERTICES = 1u << 2,
-    OPT_RADIUS = 1u << 3,
-    OPT_LAMBDA = 1u << 4,
-    OPT_RESOLUTION = 1u << 5,
-    OPT_AUTOSCALE = 1u << 6,
-    OPT_STEPS = 1u << 7,
-    OPT_TIME = 1u << 8,
-    OPT_RESIDUAL = 1u << 9,
-    OPT_OUTPUT = 1u << 10,
-    OPT_STRUTS_OUT = 1u << 11,
-    OPT_LOG = 1u << 12,
-    OPT_SNAPSHOTS = 1u << 13,
-    OPT_EVERY = 1u << 14,
-    OPT_OVERSTEP = 1u << 15,
-    OPT_RERESOLVE = 1u << 16,
-    OPT_NO_COARSE = 1u << 17,
-    OPT_DISGUISE = 1u << 18,
-    OPT_ESCAPES = 1u << 19,
-    OPT_SEED = 1u << 20
+    OPT_HELP = 'h',
+    OPT_OUTPUT = 'o',
+    OPT_JSON = 256,
+    OPT_TOLERANCE,
+    OPT_VERTICES,
+    OPT_STRUTS_OUT,
+    OPT_LOG,
+    OPT_SNAPSHOTS,
+    OPT_EVERY,
+    OPT_DISGUISE,
+    OPT_RUN = 512 /* + 2 k: run option k; + 2 k + 1: --no-NAME of a BOOL */
 };
-#define TIGHTEN_OPTIONS                                                                   \
-    (OPT_JSON | OPT_RADIUS | OPT_LAMBDA | OPT_RESOLUTION | OPT_AUTOSCALE | OPT_STEPS |     \
-     OPT_TIME | OPT_RESIDUAL | OPT_OUTPUT | OPT_STRUTS_OUT | OPT_LOG | OPT_SNAPSHOTS |     \
-     OPT_EVERY | OPT_OVERSTEP | OPT_RERESOLVE | OPT_NO_COARSE | OPT_ESCAPES | OPT_SEED)
 
-typedef struct option_spec {
-    const char *name;
-    unsigned flag;
-    bool takes_value;
-} option_spec;
-
-static const option_spec option_specs[] = {
-    {"json", OPT_JSON, false},
-    {"tolerance", OPT_TOLERANCE, true},
-    {"vertices", OPT_VERTICES, true},
-    {"radius", OPT_RADIUS, true},
-    {"lambda", OPT_LAMBDA, true},
-    {"resolution", OPT_RESOLUTION, true},
-    {"autoscale", OPT_AUTOSCALE, false},
-    {"steps", OPT_STEPS, true},
-    {"time", OPT_TIME, true},
-    {"residual", OPT_RESIDUAL, true},
-    {"output", OPT_OUTPUT, true},
-    {"struts", OPT_STRUTS_OUT, true},
-    {"log", OPT_LOG, true},
-    {"snapshots", OPT_SNAPSHOTS, true},
-    {"every", OPT_EVERY, true},
-    {"overstep", OPT_OVERSTEP, true},
-    {"re-resolve", OPT_RERESOLVE, true},
-    {"no-coarse", OPT_NO_COARSE, false},
-    {"disguise", OPT_DISGUISE, true},
-    {"escapes", OPT_ESCAPES, true},
-    {"seed", OPT_SEED, true},
+static const struct {
+    struct option o;
+    unsigned cmds;
+} own_options[] = {
+    {{"help", no_argument, NULL, OPT_HELP}, ~0u},
+    {{"json", no_argument, NULL, OPT_JSON}, CMD_INFO | CMD_STRUTS | CMD_TIGHTEN},
+    {{"tolerance", required_argument, NULL, OPT_TOLERANCE}, CMD_INFO | CMD_STRUTS},
+    {{"vertices", required_argument, NULL, OPT_VERTICES}, CMD_GENERATE},
+    {{"disguise", required_argument, NULL, OPT_DISGUISE}, CMD_GENERATE},
+    {{"output", required_argument, NULL, OPT_OUTPUT}, CMD_TIGHTEN},
+    {{"struts", required_argument, NULL, OPT_STRUTS_OUT}, CMD_TIGHTEN},
+    {{"log", required_argument, NULL, OPT_LOG}, CMD_TIGHTEN},
+    {{"snapshots", required_argument, NULL, OPT_SNAPSHOTS}, CMD_TIGHTEN},
+    {{"every", required_argument, NULL, OPT_EVERY}, CMD_TIGHTEN},
 };
+#define NOWN (sizeof own_options / sizeof own_options[0])
+
+#define NAME_SIZE 40
 
 typedef struct cli_args {
     bool help;
@@ -332,16 +289,14 @@ typedef struct cli_args {
     size_t vertices; /* 0: the generator's default */
     bool disguise;   /* generate: tk_generate_disguise with this seed */
     unsigned long long seed;
-    tk_job_options job; /* tighten's run options */
-    double overstep;    /* 0: the engine's default */
-    double re_resolve;  /* tk_options.re_resolve */
-    int escapes;        /* tk_options.escapes */
-    unsigned long long run_seed; /* tk_options.seed */
-    bool no_coarse;     /* tk_options.coarse_to_fine off */
+    tk_options run;  /* tighten's run options */
     const char *output, *struts_out, *log_out, *snapshots;
     size_t every;
     int npos;        /* the arguments that are not options, in order */
     char **pos;
+    /* the run options' names on the command line ("re-resolve",
+     * "no-coarse"), for getopt_long */
+    char names[2 * 32][NAME_SIZE];
 } cli_args;
 
 /* Prints "tightknot CMD: message" and a pointer to the help on stderr;
@@ -387,206 +342,175 @@ static int parse_integer(const char *cmd, const char *what, const char *text,
     return EXIT_OK;
 }
 
-/* Options start with '-', except "-" alone (standard input) and negative
- * numbers, which are arguments ("torus -1 3" then fails on its value, not
- * as an unknown option). */
-static bool looks_like_option(const char *arg)
+/* A run option's name on the command line: '_' as '-', "no-" first when
+ * negated. */
+static void run_option_name(char *out, const tk_field *f, bool negated)
 {
-    if (arg[0] != '-' || arg[1] == '\0')
-        return false;
-    return !((arg[1] >= '0' && arg[1] <= '9') || arg[1] == '.');
+    snprintf(out, NAME_SIZE, "%s%s", negated ? "no-" : "", f->name);
+    for (char *p = out; *p; p++)
+        if (*p == '_')
+            *p = '-';
 }
 
-/* Sets one option from its text value. */
-static int apply_option(const char *cmd, unsigned flag, const char *value, cli_args *a)
+/* Sets run option k from --NAME VALUE (or --NAME, --no-NAME for a BOOL). */
+static int apply_run_option(const char *cmd, cli_args *a, int code, const char *value)
 {
-    switch (flag) {
-    case OPT_JSON:
-        a->json = true;
+    const tk_field *f = &tk_option_fields[(code - OPT_RUN) / 2];
+    tk_error err;
+    int rc = f->kind == TK_KIND_BOOL ? tk_field_set(f, &a->run, !((code - OPT_RUN) % 2), &err)
+                                     : tk_field_parse(f, &a->run, value, &err);
+    if (rc == TK_OK)
         return EXIT_OK;
-    case OPT_TOLERANCE: {
-        double eps = 0.0;
-        if (parse_real(cmd, "--tolerance", value, &eps))
+    /* "option 'steps': ..." reads "--steps: ..." on a command line */
+    char name[NAME_SIZE];
+    run_option_name(name, f, false);
+    const char *why = strstr(err.message, "': ");
+    return usage_error(cmd, "--%s: %s", name, why ? why + 3 : err.message);
+}
+
+/* Sets one of the command line's own options from its text value. */
+static int apply_option(const char *cmd, int code, const char *value, cli_args *a)
+{
+    long long n = 0;
+    switch (code) {
+    case OPT_HELP: a->help = true; return EXIT_OK;
+    case OPT_JSON: a->json = true; return EXIT_OK;
+    case OPT_TOLERANCE:
+        if (parse_real(cmd, "--tolerance", value, &a->tolerance))
             return EXIT_USAGE;
-        if (eps < 0.0)
-            return usage_error(cmd, "--tolerance: '%s' is negative", value);
-        a->tolerance = eps;
-        return EXIT_OK;
-    }
-    case OPT_VERTICES: {
-        long long n = 0;
+        return a->tolerance < 0.0 ? usage_error(cmd, "--tolerance: '%s' is negative", value)
+                                  : EXIT_OK;
+    case OPT_VERTICES:
         if (parse_integer(cmd, "--vertices", value, 1, LLONG_MAX, &n))
             return EXIT_USAGE;
         a->vertices = (unsigned long long)n > SIZE_MAX ? SIZE_MAX : (size_t)n;
         return EXIT_OK;
-    }
-    case OPT_RADIUS:
-    case OPT_LAMBDA:
-    case OPT_RESOLUTION:
-    case OPT_TIME:
-    case OPT_RESIDUAL:
-    case OPT_STEPS: {
-        /* the run options shared with the service: one set of names,
-         * domains and messages (tk/jobspec.h) */
-        const char *name = flag == OPT_RADIUS       ? "radius"
-                           : flag == OPT_LAMBDA     ? "lambda"
-                           : flag == OPT_RESOLUTION ? "resolution"
-                           : flag == OPT_TIME       ? "time"
-                           : flag == OPT_STEPS      ? "steps"
-                                                    : "residual";
-        tk_error err;
-        if (tk_job_option_set_text(&a->job, name, value, &err) != TK_OK) {
-            /* "option 'steps': ..." reads "--steps: ..." on a command line */
-            const char *why = strstr(err.message, "': ");
-            return usage_error(cmd, "--%s: %s", name, why ? why + 3 : err.message);
-        }
-        return EXIT_OK;
-    }
-    case OPT_OVERSTEP: {
-        double x = 0.0;
-        if (parse_real(cmd, "--overstep", value, &x))
-            return EXIT_USAGE;
-        if (!(x > 0.0 && x < 0.1))
-            return usage_error(cmd, "--overstep: '%s' must be in (0, 0.1)", value);
-        a->overstep = x;
-        return EXIT_OK;
-    }
-    case OPT_RERESOLVE: {
-        double x = 0.0;
-        if (parse_real(cmd, "--re-resolve", value, &x))
-            return EXIT_USAGE;
-        if (!(x >= 0.0 && x < 1.0))
-            return usage_error(cmd, "--re-resolve: '%s' must be in [0, 1)", value);
-        a->re_resolve = x;
-        return EXIT_OK;
-    }
-    case OPT_AUTOSCALE:
-        a->job.autoscale = true;
-        return EXIT_OK;
-    case OPT_NO_COARSE:
-        a->no_coarse = true;
-        return EXIT_OK;
-    case OPT_EVERY: {
-        long long n = 0;
+    case OPT_EVERY:
         if (parse_integer(cmd, "--every", value, 1, LONG_MAX, &n))
             return EXIT_USAGE;
         a->every = (size_t)n;
         return EXIT_OK;
-    }
-    case OPT_ESCAPES: {
-        long long n = 0;
-        if (parse_integer(cmd, "--escapes", value, 0, 1000, &n))
-            return EXIT_USAGE;
-        a->escapes = (int)n;
-        return EXIT_OK;
-    }
-    case OPT_SEED: {
-        long long n = 0;
-        if (parse_integer(cmd, "--seed", value, 0, LLONG_MAX, &n))
-            return EXIT_USAGE;
-        a->run_seed = (unsigned long long)n;
-        return EXIT_OK;
-    }
-    case OPT_DISGUISE: {
-        long long n = 0;
+    case OPT_DISGUISE:
         if (parse_integer(cmd, "--disguise", value, 0, LLONG_MAX, &n))
             return EXIT_USAGE;
         a->disguise = true;
         a->seed = (unsigned long long)n;
         return EXIT_OK;
-    }
-    case OPT_OUTPUT:
-        a->output = value;
-        return EXIT_OK;
-    case OPT_STRUTS_OUT:
-        a->struts_out = value;
-        return EXIT_OK;
-    case OPT_LOG:
-        a->log_out = value;
-        return EXIT_OK;
-    case OPT_SNAPSHOTS:
-        a->snapshots = value;
-        return EXIT_OK;
-    default:
-        return usage_error(cmd, "internal error: option %u", flag);
+    case OPT_OUTPUT: a->output = value; return EXIT_OK;
+    case OPT_STRUTS_OUT: a->struts_out = value; return EXIT_OK;
+    case OPT_LOG: a->log_out = value; return EXIT_OK;
+    case OPT_SNAPSHOTS: a->snapshots = value; return EXIT_OK;
+    default: return apply_run_option(cmd, a, code, value);
     }
 }
 
-/* Parses argv[0..argc) of a subcommand, accepting the options in `allowed`
- * (and -h/--help).  The other arguments are gathered, in order, at the
- * front of argv itself (a->pos = argv), which is safe because a kept
- * argument never moves to a later slot than the one it was read from. */
-static int parse_args(const char *cmd, int argc, char **argv, unsigned allowed,
-                      cli_args *a)
+/* Parses argv[0..argc) of a subcommand (argv[0] is the first argument
+ * after its name) with getopt_long, accepting the options of `cmds` (one
+ * CMD_ bit).  The other arguments are gathered, in order, at a->pos. */
+static int parse_args(const char *cmd, int argc, char **argv, unsigned cmds, cli_args *a)
 {
-    a->help = false;
-    a->json = false;
+    memset(a, 0, sizeof *a);
     a->tolerance = DEFAULT_TOLERANCE;
-    a->vertices = 0;
-    a->disguise = false;
-    a->seed = 0;
-    tk_job_options defaults = TK_JOB_OPTIONS_INIT;
-    a->job = defaults;
-    a->overstep = 0.0;
-    a->re_resolve = 0.0;
-    {
-        tk_options engine_defaults = TK_OPTIONS_INIT;
-        a->escapes = engine_defaults.escapes;
-        a->run_seed = engine_defaults.seed;
-    }
-    a->output = a->struts_out = a->log_out = a->snapshots = NULL;
+    a->run = (tk_options)TK_OPTIONS_INIT;
     a->every = 100;
-    a->npos = 0;
-    a->pos = argv;
-    bool options_done = false;
-    for (int i = 0; i < argc; i++) {
-        char *arg = argv[i];
-        if (options_done || !looks_like_option(arg)) {
-            argv[a->npos++] = arg;
+    struct option longs[NOWN + 2 * 32 + 1];
+    char shorts[8] = "+:h";
+    size_t n = 0;
+    for (size_t k = 0; k < NOWN; k++)
+        if (own_options[k].cmds & cmds)
+            longs[n++] = own_options[k].o;
+    if (cmds & CMD_TIGHTEN) {
+        strcat(shorts, "o:");
+        for (size_t k = 0; k < tk_option_nfields && k < 32; k++) {
+            const tk_field *f = &tk_option_fields[k];
+            for (int neg = 0; f->name && neg <= (f->kind == TK_KIND_BOOL); neg++) {
+                run_option_name(a->names[2 * k + neg], f, neg);
+                longs[n++] = (struct option){a->names[2 * k + neg],
+                                             f->kind == TK_KIND_BOOL ? no_argument
+                                                                     : required_argument,
+                                             NULL, OPT_RUN + 2 * (int)k + neg};
+            }
+        }
+    }
+    longs[n] = (struct option){0};
+    /* getopt_long reads from argv[1]; "+" keeps it from permuting, so the
+     * arguments are gathered here and options may follow them */
+    char **args = argv - 1;
+    int nargs = argc + 1;
+    optind = 0; /* glibc: start afresh */
+    opterr = 0;
+    for (;;) {
+        int before = optind > 0 ? optind : 1;
+        if (before >= nargs)
+            break;
+        /* a negative number is an argument ("torus -2 3" then fails on
+         * its value, not as an unknown option) */
+        const char *next = args[before];
+        if (next[0] == '-' && (isdigit((unsigned char)next[1]) || next[1] == '.')) {
+            argv[a->npos++] = args[before];
+            optind = before + 1;
             continue;
         }
-        if (strcmp(arg, "--") == 0) {
-            options_done = true;
+        int code = getopt_long(nargs, args, shorts, longs, NULL);
+        if (code == -1 && optind == before + 1 && !strcmp(args[before], "--")) {
+            /* "--": everything after it is an argument */
+            while (optind < nargs)
+                argv[a->npos++] = args[optind++];
+            break;
+        }
+        if (code == -1) {
+            argv[a->npos++] = args[optind++];
             continue;
         }
-        if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
-            a->help = true;
-            continue;
-        }
-        if (strcmp(arg, "-o") == 0 && (allowed & OPT_OUTPUT)) {
-            if (i + 1 >= argc)
-                return usage_error(cmd, "option -o needs a value");
-            a->output = argv[++i];
-            continue;
-        }
-        const option_spec *spec = NULL;
-        const char *eq = NULL;
-        if (arg[1] == '-') {
-            const char *name = arg + 2;
-            eq = strchr(name, '=');
-            size_t len = eq ? (size_t)(eq - name) : strlen(name);
-            for (size_t k = 0; k < sizeof option_specs / sizeof option_specs[0]; k++)
-                if ((option_specs[k].flag & allowed) && strlen(option_specs[k].name) == len &&
-                    strncmp(option_specs[k].name, name, len) == 0)
-                    spec = &option_specs[k];
-        }
-        if (!spec)
-            return usage_error(cmd, "unknown option '%s'", arg);
-        const char *value = NULL;
-        if (spec->takes_value) {
-            if (eq)
-                value = eq + 1;
-            else if (i + 1 < argc)
-                value = argv[++i];
-            else
-                return usage_error(cmd, "option --%s needs a value", spec->name);
-        } else if (eq) {
-            return usage_error(cmd, "option --%s takes no value", spec->name);
-        }
-        if (apply_option(cmd, spec->flag, value, a))
+        if (code == '?')
+            return usage_error(cmd, "unknown option '%s'", args[optind - 1]);
+        if (code == ':')
+            return usage_error(cmd, "option %s needs a value", args[optind - 1]);
+        if (apply_option(cmd, code, optarg, a))
             return EXIT_USAGE;
     }
+    a->pos = argv;
     return EXIT_OK;
+}
+
+/* The named run options, as tighten's --help lists them. */
+static void print_run_options(FILE *out)
+{
+    for (size_t k = 0; k < tk_option_nfields; k++) {
+        const tk_field *f = &tk_option_fields[k];
+        if (!f->name)
+            continue;
+        char name[NAME_SIZE], flag[2 * NAME_SIZE + 8];
+        run_option_name(name, f, false);
+        if (f->kind == TK_KIND_BOOL)
+            snprintf(flag, sizeof flag, "--%s, --no-%s", name, name);
+        else
+            snprintf(flag, sizeof flag, "--%s X", name);
+        char dflt[48];
+        if (f->kind == TK_KIND_BOOL)
+            snprintf(dflt, sizeof dflt, "%s", f->dflt != 0.0 ? "on" : "off");
+        else
+            snprintf(dflt, sizeof dflt, "%g", f->dflt);
+        /* the help wrapped at 76 columns, under the flag */
+        fprintf(out, "  %s\n", flag);
+        char text[1024];
+        snprintf(text, sizeof text, "%s (default %s)", f->help, dflt);
+        const char *p = text;
+        while (*p) {
+            size_t len = strlen(p), cut = len;
+            if (len > 68) {
+                cut = 68;
+                while (cut > 0 && p[cut] != ' ')
+                    cut--;
+                if (cut == 0)
+                    cut = 68;
+            }
+            fprintf(out, "        %.*s\n", (int)cut, p);
+            p += cut;
+            while (*p == ' ')
+                p++;
+        }
+    }
 }
 
 /* ---------------------------------------------------------------- output */
@@ -741,7 +665,7 @@ static int info_one(const char *name, const cli_args *a, int width, bool *header
 static int cmd_info(int argc, char **argv)
 {
     cli_args a;
-    if (parse_args("info", argc, argv, OPT_JSON | OPT_TOLERANCE, &a))
+    if (parse_args("info", argc, argv, CMD_INFO, &a))
         return EXIT_USAGE;
     if (a.help) {
         fputs(info_help, stdout);
@@ -820,7 +744,7 @@ static json_t *struts_json(const char *name, const tk_curve *c, double thickness
 static int cmd_struts(int argc, char **argv)
 {
     cli_args a;
-    if (parse_args("struts", argc, argv, OPT_JSON | OPT_TOLERANCE, &a))
+    if (parse_args("struts", argc, argv, CMD_STRUTS, &a))
         return EXIT_USAGE;
     if (a.help) {
         fputs(struts_help, stdout);
@@ -900,7 +824,7 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
 static int cmd_generate(int argc, char **argv)
 {
     cli_args a;
-    if (parse_args("generate", argc, argv, OPT_VERTICES | OPT_DISGUISE, &a))
+    if (parse_args("generate", argc, argv, CMD_GENERATE, &a))
         return EXIT_USAGE;
     if (a.help) {
         fputs(generate_help, stdout);
@@ -963,11 +887,9 @@ static int write_vect_file(const char *path, const tk_curve *c)
 static int tighten_progress(const tk_step_report *s, void *user)
 {
     tighten_watch *w = user;
-    if (w->log)
-        fprintf(w->log, "%ld\t%.6f\t%.12g\t%.12g\t%.12g\t%.12g\t%.6g\t%zu\t%zu\t%.6g\t%.6g\t%.3g\t%d\t%d\n",
-                s->step, s->seconds, s->ropelength, s->length, s->thickness, s->minrad,
-                s->residual, s->struts, s->kinks, s->step_size, s->rcond, s->violation,
-                s->corrections, s->escapes);
+    for (size_t k = 0; w->log && k < tk_step_nfields; k++)
+        fprintf(w->log, "%.17g%c", tk_field_get(&tk_step_fields[k], s),
+                k + 1 < tk_step_nfields ? '\t' : '\n');
     if (w->snapshots && s->step % (long)w->every == 0) {
         char path[4096];
         snprintf(path, sizeof path, "%s/step-%06ld.vect", w->snapshots, s->step);
@@ -1009,26 +931,20 @@ static int write_struts_file(const char *path, const char *name, tk_run *run)
 static int cmd_tighten(int argc, char **argv)
 {
     cli_args a;
-    if (parse_args("tighten", argc, argv, TIGHTEN_OPTIONS, &a))
+    if (parse_args("tighten", argc, argv, CMD_TIGHTEN, &a))
         return EXIT_USAGE;
     if (a.help) {
         fputs(tighten_help, stdout);
+        print_run_options(stdout);
+        fputs(tighten_help_end, stdout);
         return EXIT_OK;
     }
     if (a.npos != 1)
         return usage_error("tighten", a.npos == 0 ? "no FILE given" : "one FILE only");
-    tk_options run_opts;
-    tk_job_options_to_run(&a.job, &run_opts);
-    run_opts.snapshot_every = 0; /* the snapshots are files, written here */
-    if (a.overstep > 0.0) {
-        run_opts.overstep_tolerance = a.overstep;
-        run_opts.correction_tolerance = 0.1 * a.overstep;
-    }
-    run_opts.re_resolve = a.re_resolve;
-    run_opts.coarse_to_fine = !a.no_coarse;
-    run_opts.escapes = a.escapes;
-    run_opts.seed = a.run_seed;
-    if (a.re_resolve > 0.0 && !(a.job.resolution > 0.0))
+    tk_options run_opts = a.run;
+    if (!tk_options_have_stop(&run_opts))
+        run_opts.max_steps = TK_DEFAULT_STEPS;
+    if (run_opts.re_resolve > 0.0 && !(run_opts.resolution > 0.0))
         return usage_error("tighten", "--re-resolve needs --resolution (the vertices per unit "
                                       "ropelength to keep)");
     const char *name = a.pos[0];
@@ -1052,9 +968,8 @@ static int cmd_tighten(int argc, char **argv)
             tk_curve_free(&c);
             return EXIT_INPUT;
         }
-        fputs("step\tseconds\tropelength\tlength\tthickness\tminrad\tresidual\tstruts\tkinks\t"
-              "step_size\trcond\tviolation\tcorrections\tescapes\n",
-              w.log);
+        for (size_t k = 0; k < tk_step_nfields; k++)
+            fprintf(w.log, "%s%c", tk_step_fields[k].name, k + 1 < tk_step_nfields ? '\t' : '\n');
     }
     tk_run *run = NULL;
     int status = EXIT_OK;
@@ -1083,19 +998,15 @@ static int cmd_tighten(int argc, char **argv)
     const tk_step_report *last = tk_run_latest(run);
     const tk_curve *fin = tk_run_curve(run);
     if (a.json) {
+        /* the last step's figures, and "steps" as before them */
         json_t *o = json_object();
         json_object_set_new(o, "file", tk_json_text(name));
-        json_object_set_new(o, "ropelength", tk_json_number(last->ropelength));
-        json_object_set_new(o, "length", tk_json_number(last->length));
-        json_object_set_new(o, "thickness", tk_json_number(last->thickness));
-        json_object_set_new(o, "minrad", tk_json_number(last->minrad));
-        json_object_set_new(o, "vertices", json_integer((json_int_t)fin->nvert));
+        json_t *figures = tk_json_step(last);
+        json_object_update(o, figures);
+        json_decref(figures);
         json_object_set_new(o, "components", json_integer((json_int_t)fin->ncomp));
         json_object_set_new(o, "steps", json_integer((json_int_t)last->step));
-        json_object_set_new(o, "seconds", tk_json_number(last->seconds));
-        json_object_set_new(o, "residual", tk_json_number(last->residual));
-        json_object_set_new(o, "struts", json_integer((json_int_t)last->struts));
-        json_object_set_new(o, "kinks", json_integer((json_int_t)last->kinks));
+        json_object_set_new(o, "options", tk_json_options(&run_opts));
         json_object_set_new(o, "stop_reason", json_string(tk_stop_reason_name(why)));
         json_object_set_new(o, "invariants",
                             json_pack("{s:o, s:o}", "start",

@@ -25,7 +25,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "tk/jobspec.h"
+#include "tk/record.h"
 
 enum { REMOTE_OK = 0, REMOTE_USAGE = 1, REMOTE_FAILED = 2, REMOTE_SERVER = 3 };
 
@@ -50,10 +50,11 @@ const char tk_remote_help[] =
     "                  the server, with their results\n"
     "  fetch [--out DIR] JOB...   download jobs' VECT and struts into DIR\n"
     "\n"
-    "Run options (as for tightknot tighten): --resolution R, --steps N,\n"
-    "--time SECONDS, --residual X, --radius R, --lambda L, --autoscale,\n"
-    "--every K (keep a frame every K steps), --escapes N, --seed S.  With\n"
-    "none of steps, time and residual a job stops after 1000 steps.\n"
+    "Run options: those of tightknot tighten, by the same names (see\n"
+    "'tightknot tighten --help': --resolution R, --steps N, --time SECONDS,\n"
+    "--residual X, --autoscale, --escapes N, ...), and --every K (keep a\n"
+    "frame every K steps).  With none of steps, time and residual a job\n"
+    "stops after 1000 steps.\n"
     "\n"
     "Options:\n"
     "  --server URL   the service (default $TIGHTKNOT_SERVER, else\n"
@@ -851,7 +852,8 @@ int tk_remote_main(int argc, char **argv)
     a.parallel = 4;
     a.poll = 1.0;
     bool json = false;
-    tk_job_options opts = TK_JOB_OPTIONS_INIT;
+    tk_options run = TK_OPTIONS_INIT; /* the job's run options */
+    long every = 0;                   /* its frames */
     const char *command = NULL;
     char **rest = calloc((size_t)argc + 1, sizeof *rest);
     int nrest = 0;
@@ -879,10 +881,22 @@ int tk_remote_main(int argc, char **argv)
             continue;
         }
         const char *name = arg + 2;
+        /* a run option (tk/record.h): --name, '_' written '-'; a BOOL as
+         * --name or --no-name */
+        char field_name[64];
+        snprintf(field_name, sizeof field_name, "%s", name);
+        for (char *p = field_name; *p; p++)
+            *p = *p == '-' ? '_' : *p;
+        bool negated = !strncmp(field_name, "no_", 3);
+        const tk_field *f = tk_field_find(tk_option_fields, tk_option_nfields,
+                                          negated ? field_name + 3 : field_name);
+        if (f && negated && f->kind != TK_KIND_BOOL)
+            f = NULL;
+        tk_error err;
         if (!strcmp(name, "json")) {
             json = true;
-        } else if (!strcmp(name, "autoscale")) {
-            opts.autoscale = true;
+        } else if (f && f->kind == TK_KIND_BOOL) {
+            tk_field_set(f, &run, !negated, NULL);
         } else if (!has_value) {
             fprintf(stderr, "tightknot remote: %s needs a value\n", arg);
             status = REMOTE_USAGE;
@@ -904,12 +918,21 @@ int tk_remote_main(int argc, char **argv)
             } else {
                 a.poll = x;
             }
-        } else if (tk_job_option_known(name)) {
-            tk_error err;
-            if (tk_job_option_set_text(&opts, name, argv[++i], &err) != TK_OK) {
+        } else if (f) {
+            if (tk_field_parse(f, &run, argv[++i], &err) != TK_OK) {
                 fprintf(stderr, "tightknot remote: %s\n", err.message);
                 status = REMOTE_USAGE;
             }
+        } else if (!strcmp(name, "every")) {
+            char *end = NULL;
+            errno = 0;
+            long long n = strtoll(argv[++i], &end, 10);
+            if (end == argv[i] || *end || errno || n < 0 || n > 100000000) {
+                fprintf(stderr, "tightknot remote: --every: '%s' must be a whole number from 0 "
+                                "to 100000000\n", argv[i]);
+                status = REMOTE_USAGE;
+            }
+            every = (long)n;
         } else {
             fprintf(stderr, "tightknot remote: unknown option '%s'\n", arg);
             status = REMOTE_USAGE;
@@ -926,22 +949,20 @@ int tk_remote_main(int argc, char **argv)
     }
     /* the options as a query string, only those that differ from the
      * defaults, so the server's defaults stay the server's */
-    tk_job_options defaults = TK_JOB_OPTIONS_INIT;
+    tk_options defaults = TK_OPTIONS_INIT;
     size_t q = 0;
-#define QUERY(cond, ...)                                                                      \
-    if (cond)                                                                                 \
-    q += (size_t)snprintf(a.query + q, sizeof a.query - q, __VA_ARGS__)
-    QUERY(opts.resolution != defaults.resolution, "&resolution=%.17g", opts.resolution);
-    QUERY(opts.steps != defaults.steps, "&steps=%ld", opts.steps);
-    QUERY(opts.time != defaults.time, "&time=%.17g", opts.time);
-    QUERY(opts.residual != defaults.residual, "&residual=%.17g", opts.residual);
-    QUERY(opts.radius != defaults.radius, "&radius=%.17g", opts.radius);
-    QUERY(opts.lambda != defaults.lambda, "&lambda=%.17g", opts.lambda);
-    QUERY(opts.autoscale, "&autoscale=true");
-    QUERY(opts.every != defaults.every, "&every=%ld", opts.every);
-    QUERY(opts.escapes != defaults.escapes, "&escapes=%ld", opts.escapes);
-    QUERY(opts.seed != defaults.seed, "&seed=%ld", opts.seed);
-#undef QUERY
+    for (size_t k = 0; k < tk_option_nfields; k++) {
+        const tk_field *f = &tk_option_fields[k];
+        double x = tk_field_get(f, &run);
+        if (f->name && x != tk_field_get(f, &defaults) && q < sizeof a.query)
+            q += (size_t)(f->kind == TK_KIND_BOOL
+                              ? snprintf(a.query + q, sizeof a.query - q, "&%s=%s", f->name,
+                                         x != 0.0 ? "true" : "false")
+                              : snprintf(a.query + q, sizeof a.query - q, "&%s=%.17g",
+                                         f->name, x));
+    }
+    if (every > 0 && q < sizeof a.query)
+        snprintf(a.query + q, sizeof a.query - q, "&every=%ld", every);
 
     client c;
     memset(&c, 0, sizeof c);

@@ -43,61 +43,85 @@
 #include "tk/invariants.h"
 #include "tk/struts.h"
 
+/* A record's fields are listed once, in an X-macro table; the struct,
+ * its defaults and every mapping (tk/record.h: the command line, HTTP
+ * queries, JSON, the store) are generated from it.  Each row is
+ *   X(field, KIND, default, min, max, name, help)
+ * KIND one of REAL (double), LONG, INT, SIZE (size_t), BOOL and SEED
+ * (unsigned long long); the value must lie in [min, max]; `name` is how
+ * users give it (NULL: the engine's own, set in code only); `help` says
+ * what it means, as --help and the API's documentation show it. */
+#define TK_CTYPE_REAL double
+#define TK_CTYPE_LONG long
+#define TK_CTYPE_INT int
+#define TK_CTYPE_SIZE size_t
+#define TK_CTYPE_BOOL bool
+#define TK_CTYPE_SEED unsigned long long
+#define TK_FIELD_DECLARE(field, kind, ...) TK_CTYPE_##kind field;
+#define TK_FIELD_DEFAULT(field, kind, dflt, ...) .field = dflt,
+
+/* The run options.  The stop criteria (steps, time, residual, change):
+ * 0 leaves one unused, the run stops at the first met.  Tolerances are
+ * relative to the diameter tau = 2 radius. */
+#define TK_OPTION_FIELDS(X)                                                                  \
+    X(radius, REAL, 0.5, 1e-30, 1e30, "radius",                                              \
+      "tube radius; the diameter, the thickness the run keeps, is twice it")                 \
+    X(lambda, REAL, 1.0, 1e-30, 1e30, "lambda", "stiffness: minrad >= lambda x radius")      \
+    X(resolution, REAL, 0.0, 0.0, 1e4, "resolution",                                         \
+      "resample the start to resolution x ropelength vertices (5 quick, 10 medium, 20 "      \
+      "fine); 0 keeps the input's")                                                          \
+    X(autoscale, BOOL, false, 0, 1, "autoscale",                                             \
+      "first scale the start so that its thickness is just above the diameter (needed "      \
+      "when it is thinner)")                                                                 \
+    X(autoscale_margin, REAL, 1.002, 1.0, 1.5, NULL, "autoscale's thickness / diameter")     \
+    X(max_steps, LONG, 0, 0, 1e8, "steps", "stop after this many steps (0: no limit)")       \
+    X(max_seconds, REAL, 0.0, 0.0, 604800, "time",                                           \
+      "stop after this many seconds, at most a week (0: no limit)")                          \
+    X(min_residual, REAL, 0.0, 0.0, 1.0, "residual",                                         \
+      "stop when the residual |resolved gradient| / |gradient| falls below this (0: "        \
+      "never)")                                                                              \
+    X(min_change, REAL, 0.0, 0.0, 1.0, NULL,                                                 \
+      "stop when the ropelength fell by less than this (relative) over change_window "       \
+      "steps")                                                                               \
+    X(change_window, SIZE, 20, 1, 1e8, NULL, "steps of the change criterion")               \
+    X(active_tolerance, REAL, 3e-4, 1e-12, 0.4, NULL,                                        \
+      "constraints this close are active; a third of it each time the ropelength all but "   \
+      "stops falling, four times at most (the polishing; the overstep tolerance then "       \
+      "stays below it)")                                                                     \
+    X(overstep_tolerance, REAL, 1e-5, 1e-12, 0.09, "overstep",                               \
+      "largest constraint violation a step may make, as a fraction of the diameter; "        \
+      "violations are corrected down to a tenth of it")                                      \
+    X(equalise, REAL, 0.5, 0.0, 1e3, NULL, "gain of the edge-equalising motion")            \
+    X(snapshot_every, SIZE, 0, 0, 1e8, NULL, "keep the curve every this many steps (0: "     \
+      "never)")                                                                              \
+    X(re_resolve, REAL, 0.0, 0.0, 0.9, "re_resolve",                                         \
+      "with a resolution: each time the ropelength has fallen by this fraction, resample "   \
+      "to resolution x ropelength vertices again (0: never)")                                \
+    X(coarse_to_fine, BOOL, true, 0, 1, "coarse",                                            \
+      "with a resolution: start with half the vertices (a quarter, ... while 2.5 per unit "  \
+      "ropelength remain) and double them whenever the ropelength all but stops falling")    \
+    X(escapes, INT, 8, 0, 1000, "escapes",                                                   \
+      "most escapes: each time the ropelength all but stops falling on the final polygon "   \
+      "while a tenth of the budget is left, the best curve so far is deformed at random "    \
+      "and tightened again; the result is the best curve found (0: none)")                  \
+    X(seed, SEED, 1, 0, 9007199254740992.0, "seed",                                          \
+      "of the escapes' random deformations: the same seed, the same run")
+
+/* The snapshots (snapshot_every) keep one vertex count: they cannot be
+ * combined with re_resolve, and a run with them does not go coarse to
+ * fine.  The escapes (escape.c): after the final polygon has converged,
+ * the best curve so far is deformed by a smooth random displacement,
+ * made feasible and tightened again (coarse to fine where the run is);
+ * a run returns the best curve it found. */
 typedef struct tk_options {
-    double radius;               /* tube radius in [1e-30, 1e30] (the range of
-                                  * tk_curve_check_range); the diameter tau is 2 radius */
-    double lambda;               /* stiffness: minrad >= lambda * radius */
-    double resolution;           /* re-resolve to ceil(resolution * ropelength)
-                                    vertices at the start; 0 keeps the input */
-    bool autoscale;              /* scale so thickness = autoscale_margin * tau */
-    double autoscale_margin;
-    /* Stop criteria; 0 leaves one unused.  The run stops at the first met. */
-    long max_steps;
-    double max_seconds;
-    double min_residual;         /* stop when residual < this */
-    double min_change;           /* stop when ropelength fell by less than
-                                    this (relative) over change_window steps */
-    size_t change_window;
-    /* Tolerances, relative to the diameter tau. */
-    double active_tolerance;     /* constraints this close are active; a third
-                                    of it each time the ropelength all but
-                                    stops falling, four times at most (the
-                                    polishing; the overstep and correction
-                                    tolerances then stay below it) */
-    double overstep_tolerance;   /* largest violation a step may introduce */
-    double correction_tolerance; /* violations above this are corrected */
-    double equalise;             /* gain of the edge-equalising motion */
-    size_t snapshot_every;       /* keep the curve every K steps (0: never) */
-    double re_resolve;           /* with resolution > 0: whenever the ropelength
-                                    has fallen by this fraction since the last
-                                    resampling and the vertex count is that
-                                    much finer than resolution * ropelength,
-                                    resample to that count (and scale up just
-                                    enough to stay feasible); 0: never.  The
-                                    vertex count then changes during the run,
-                                    so it cannot be combined with snapshots. */
-    bool coarse_to_fine;         /* with resolution > 0 and no snapshots: start
-                                    with half the vertices (a quarter, ...,
-                                    while that leaves 2.5 per unit
-                                    ropelength) and double them each time the
-                                    ropelength all but stops falling, up to
-                                    the resolution's count */
-    /* Escapes from critical points that are not the minimum (escape.c):
-     * each time the ropelength all but stops falling on the final polygon
-     * (or a convergence criterion is met) while tries and budget remain,
-     * the best curve so far is deformed at random, made feasible and
-     * tightened again (coarse to fine where the run is); the run returns
-     * the best curve found.  0 turns them off. */
-    int escapes;                 /* most tries */
-    unsigned long long seed;     /* of the random deformations: the same
-                                    seed, the same run */
+    TK_OPTION_FIELDS(TK_FIELD_DECLARE)
 } tk_options;
 
-#define TK_OPTIONS_INIT                                                                  \
-    {                                                                                    \
-        0.5, 1.0, 0.0, false, 1.002, 0, 0.0, 0.0, 0.0, 20, 3e-4, 1e-5, 1e-6, 0.5, 0, 0.0, \
-            true, 8, 1                                                                   \
-    }
+#define TK_OPTIONS_INIT {TK_OPTION_FIELDS(TK_FIELD_DEFAULT)}
+
+/* With none of steps, time, residual and change set, the command line and
+ * the service stop a run after this many steps. */
+#define TK_DEFAULT_STEPS 1000
 
 /* Why a run stopped. */
 typedef enum tk_stop_reason {
@@ -113,23 +137,28 @@ typedef enum tk_stop_reason {
 
 const char *tk_stop_reason_name(tk_stop_reason r);
 
-/* The figures of one step (also the run's history). */
+/* The figures of one step (also the run's history); rows as for the
+ * options, without domains. */
+#define TK_STEP_FIELDS(X)                                                                    \
+    X(step, LONG, 0, 0, 0, "step", "1 for the first step; 0 for the start")                 \
+    X(seconds, REAL, 0, 0, 0, "seconds", "wall time since the run started")                 \
+    X(ropelength, REAL, 0, 0, 0, "ropelength", "2 length / thickness (Definition 1)")       \
+    X(length, REAL, 0, 0, 0, "length", "of the curve")                                      \
+    X(thickness, REAL, 0, 0, 0, "thickness", "the tube diameter (Definition 1)")            \
+    X(minrad, REAL, 0, 0, 0, "minrad", "smallest radius of curvature (equation 3)")         \
+    X(residual, REAL, 0, 0, 0, "residual", "|-grad L + A x| / |grad L|")                    \
+    X(struts, SIZE, 0, 0, 0, "struts", "active struts")                                     \
+    X(kinks, SIZE, 0, 0, 0, "kinks", "active kinks")                                        \
+    X(step_size, REAL, 0, 0, 0, "step_size", "h of the step taken")                         \
+    X(rcond, REAL, 0, 0, 0, "rcond", "NNLS condition estimate (1 without constraints)")    \
+    X(violation, REAL, 0, 0, 0, "violation",                                                \
+      "worst constraint violation after the step / tau")                                     \
+    X(corrections, INT, 0, 0, 0, "corrections", "Newton iterations after the step")         \
+    X(vertices, SIZE, 0, 0, 0, "vertices", "of the curve")                                  \
+    X(escapes, INT, 0, 0, 0, "escapes", "escapes tried so far (tk_run_escapes)")
+
 typedef struct tk_step_report {
-    long step;               /* 1 for the first step; 0 for the start */
-    double seconds;          /* wall time since the run started */
-    double ropelength;       /* 2 length / thickness (Definition 1) */
-    double length;
-    double thickness;        /* Definition 1 */
-    double minrad;
-    double residual;         /* |-grad L + A x| / |grad L| */
-    size_t struts;           /* active struts */
-    size_t kinks;            /* active kinks */
-    double step_size;        /* h of the step taken */
-    double rcond;            /* NNLS condition estimate (1 without constraints) */
-    double violation;        /* worst constraint violation after the step / tau */
-    int corrections;         /* Newton iterations after the step */
-    size_t vertices;
-    int escapes;             /* escapes tried so far (tk_run_escapes) */
+    TK_STEP_FIELDS(TK_FIELD_DECLARE)
 } tk_step_report;
 
 typedef struct tk_run tk_run;

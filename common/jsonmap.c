@@ -1,5 +1,5 @@
-/* tightknot: JSON forms of the engine's results (see include/tk/jsonmap.h). */
-#include "tk/jsonmap.h"
+/* tightknot: JSON forms of the engine's results (see common/jsonmap.h). */
+#include "jsonmap.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -34,27 +34,61 @@ json_t *tk_json_text(const char *s)
     return j;
 }
 
-json_t *tk_json_step(const tk_step_report *s)
+json_t *tk_json_record(const tk_field *table, size_t n, const void *record)
 {
     json_t *o = json_object();
-    if (!o)
-        return NULL;
-    json_object_set_new(o, "step", json_integer((json_int_t)s->step));
-    json_object_set_new(o, "seconds", tk_json_number(s->seconds));
-    json_object_set_new(o, "ropelength", tk_json_number(s->ropelength));
-    json_object_set_new(o, "length", tk_json_number(s->length));
-    json_object_set_new(o, "thickness", tk_json_number(s->thickness));
-    json_object_set_new(o, "minrad", tk_json_number(s->minrad));
-    json_object_set_new(o, "residual", tk_json_number(s->residual));
-    json_object_set_new(o, "struts", json_integer((json_int_t)s->struts));
-    json_object_set_new(o, "kinks", json_integer((json_int_t)s->kinks));
-    json_object_set_new(o, "step_size", tk_json_number(s->step_size));
-    json_object_set_new(o, "rcond", tk_json_number(s->rcond));
-    json_object_set_new(o, "violation", tk_json_number(s->violation));
-    json_object_set_new(o, "corrections", json_integer(s->corrections));
-    json_object_set_new(o, "vertices", json_integer((json_int_t)s->vertices));
-    json_object_set_new(o, "escapes", json_integer(s->escapes));
+    for (size_t i = 0; o && i < n; i++) {
+        const tk_field *f = &table[i];
+        double x = tk_field_get(f, record);
+        if (f->name)
+            json_object_set_new(o, f->name,
+                                f->kind == TK_KIND_REAL   ? tk_json_number(x)
+                                : f->kind == TK_KIND_BOOL ? json_boolean(x != 0.0)
+                                                          : json_integer((json_int_t)x));
+    }
     return o;
+}
+
+int tk_json_record_set(const tk_field *table, size_t n, void *record, const json_t *obj,
+                       const char **bad, tk_error *err)
+{
+    if (bad)
+        *bad = NULL;
+    if (!json_is_object(obj))
+        return tk_error_set(err, TK_EINVAL, "expected a JSON object");
+    const char *name;
+    json_t *value;
+    /* json_object_foreach wants a non-const object; it does not modify it */
+    json_object_foreach((json_t *)obj, name, value) {
+        const tk_field *f = tk_field_find(table, n, name);
+        int rc = TK_OK;
+        if (!f)
+            rc = tk_error_set(err, TK_EINVAL, "unknown option '%.60s'", name);
+        else if (f->kind == TK_KIND_BOOL ? !json_is_boolean(value) : !json_is_number(value))
+            rc = tk_error_set(err, TK_EINVAL, "option '%s': expected %s", name,
+                              f->kind == TK_KIND_BOOL ? "true or false" : "a number");
+        else
+            rc = tk_field_set(f, record,
+                              json_is_boolean(value) ? json_is_true(value)
+                                                     : json_number_value(value),
+                              err);
+        if (rc) {
+            if (bad)
+                *bad = name;
+            return rc;
+        }
+    }
+    return TK_OK;
+}
+
+json_t *tk_json_step(const tk_step_report *s)
+{
+    return tk_json_record(tk_step_fields, tk_step_nfields, s);
+}
+
+json_t *tk_json_options(const tk_options *o)
+{
+    return tk_json_record(tk_option_fields, tk_option_nfields, o);
 }
 
 json_t *tk_json_escapes(const tk_escape *e, size_t count)

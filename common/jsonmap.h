@@ -13,6 +13,7 @@
 
 #include "tk/curve.h"
 #include "tk/invariants.h"
+#include "tk/record.h"
 #include "tk/struts.h"
 #include "tk/tighten.h"
 
@@ -23,8 +24,23 @@ json_t *tk_json_point(const double p[3]);
  * the text is not valid UTF-8. */
 json_t *tk_json_text(const char *s);
 
+/* The named fields of a record (tk/record.h) as a JSON object: whole
+ * kinds as integers, BOOL as true or false, reals that are not finite as
+ * null. */
+json_t *tk_json_record(const tk_field *table, size_t n, const void *record);
+
+/* Sets the fields named in the JSON object obj.  TK_EINVAL when obj is not
+ * an object, a name is unknown or a value is of the wrong type or out of
+ * its domain; *bad (when not NULL) then points at the name (valid while
+ * obj lives) and the record may have been changed by the names before. */
+int tk_json_record_set(const tk_field *table, size_t n, void *record, const json_t *obj,
+                       const char **bad, tk_error *err);
+
 /* One step's figures, every field of tk_step_report. */
 json_t *tk_json_step(const tk_step_report *s);
+
+/* The run options users can give (the named fields of tk_options). */
+json_t *tk_json_options(const tk_options *o);
 
 /* The escapes a run tried (tk_run_escapes): [{"step", "from", "amplitude",
  * "reached" (null while under way), "improved"}]. */

@@ -1,0 +1,120 @@
+/* tightknot: the fields of a record, by name (see include/tk/record.h). */
+#include "tk/record.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define KIND_OF_REAL TK_KIND_REAL
+#define KIND_OF_LONG TK_KIND_LONG
+#define KIND_OF_INT TK_KIND_INT
+#define KIND_OF_SIZE TK_KIND_SIZE
+#define KIND_OF_BOOL TK_KIND_BOOL
+#define KIND_OF_SEED TK_KIND_SEED
+
+#define OPTION_ROW(fld, kind, dflt, lo, hi, nm, hlp)                                     \
+    {#fld, nm, KIND_OF_##kind, offsetof(tk_options, fld), (double)(dflt), lo, hi, hlp},
+#define STEP_ROW(fld, kind, dflt, lo, hi, nm, hlp)                                       \
+    {#fld, nm, KIND_OF_##kind, offsetof(tk_step_report, fld), 0.0, lo, hi, hlp},
+
+const tk_field tk_option_fields[] = {TK_OPTION_FIELDS(OPTION_ROW)};
+const size_t tk_option_nfields = sizeof tk_option_fields / sizeof tk_option_fields[0];
+const tk_field tk_step_fields[] = {TK_STEP_FIELDS(STEP_ROW)};
+const size_t tk_step_nfields = sizeof tk_step_fields / sizeof tk_step_fields[0];
+
+const tk_field *tk_field_find(const tk_field *table, size_t n, const char *name)
+{
+    for (size_t i = 0; name && i < n; i++)
+        if (table[i].name && !strcmp(table[i].name, name))
+            return &table[i];
+    return NULL;
+}
+
+double tk_field_get(const tk_field *f, const void *record)
+{
+    const char *p = (const char *)record + f->offset;
+    switch (f->kind) {
+    case TK_KIND_LONG: return (double)*(const long *)p;
+    case TK_KIND_INT: return (double)*(const int *)p;
+    case TK_KIND_SIZE: return (double)*(const size_t *)p;
+    case TK_KIND_BOOL: return *(const bool *)p ? 1.0 : 0.0;
+    case TK_KIND_SEED: return (double)*(const unsigned long long *)p;
+    case TK_KIND_REAL:
+    default: return *(const double *)p;
+    }
+}
+
+static const char *label(const tk_field *f)
+{
+    return f->name ? f->name : f->field;
+}
+
+int tk_field_set(const tk_field *f, void *record, double x, tk_error *err)
+{
+    if (!isfinite(x))
+        return tk_error_set(err, TK_EINVAL, "option '%s': must be a finite number", label(f));
+    if (f->kind != TK_KIND_REAL && x != floor(x))
+        return tk_error_set(err, TK_EINVAL, "option '%s': must be a whole number, not %.17g",
+                            label(f), x);
+    if (!(x >= f->min && x <= f->max))
+        return tk_error_set(err, TK_EINVAL, "option '%s': must be from %.17g to %.17g, not %.17g",
+                            label(f), f->min, f->max, x);
+    char *p = (char *)record + f->offset;
+    switch (f->kind) {
+    case TK_KIND_LONG: *(long *)p = (long)x; break;
+    case TK_KIND_INT: *(int *)p = (int)x; break;
+    case TK_KIND_SIZE: *(size_t *)p = (size_t)x; break;
+    case TK_KIND_BOOL: *(bool *)p = x != 0.0; break;
+    case TK_KIND_SEED: *(unsigned long long *)p = (unsigned long long)x; break;
+    case TK_KIND_REAL:
+    default: *(double *)p = x; break;
+    }
+    return TK_OK;
+}
+
+int tk_field_parse(const tk_field *f, void *record, const char *text, tk_error *err)
+{
+    if (!text || !*text)
+        return tk_error_set(err, TK_EINVAL, "option '%s': no value given", label(f));
+    if (f->kind == TK_KIND_BOOL) {
+        static const char *const yes[] = {"true", "yes", "1"}, *const no[] = {"false", "no", "0"};
+        for (int k = 0; k < 3; k++)
+            if (!strcmp(text, yes[k]) || !strcmp(text, no[k]))
+                return tk_field_set(f, record, !strcmp(text, yes[k]), err);
+        return tk_error_set(err, TK_EINVAL, "option '%s': expected true or false, found '%.40s'",
+                            label(f), text);
+    }
+    /* decimal only: strtod would also read hexadecimal, inf and nan */
+    char *end = NULL;
+    errno = 0;
+    double x = strtod(text, &end);
+    if (strspn(text, "0123456789+-.eE") != strlen(text) || end == text || *end ||
+        errno == ERANGE)
+        return tk_error_set(err, TK_EINVAL, "option '%s': expected a number, found '%.40s'",
+                            label(f), text);
+    return tk_field_set(f, record, x, err);
+}
+
+int tk_options_check(const tk_options *o, tk_error *err)
+{
+    for (size_t i = 0; i < tk_option_nfields; i++) {
+        tk_options copy = *o;
+        int rc = tk_field_set(&tk_option_fields[i], &copy, tk_field_get(&tk_option_fields[i], o),
+                              err);
+        if (rc)
+            return rc;
+    }
+    if (o->re_resolve > 0.0 && o->snapshot_every > 0)
+        return tk_error_set(err, TK_EINVAL,
+                            "re_resolve changes the vertex count, which snapshots keep: "
+                            "use one or the other");
+    return TK_OK;
+}
+
+bool tk_options_have_stop(const tk_options *o)
+{
+    return o->max_steps > 0 || o->max_seconds > 0.0 || o->min_residual > 0.0 ||
+           o->min_change > 0.0;
+}

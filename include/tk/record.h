@@ -1,0 +1,67 @@
+/* tightknot: the fields of a record, by name.
+ *
+ * The run options and the step report are each written down once, as an
+ * X-macro table (tk/tighten.h).  This module turns a table into field
+ * descriptors (name, kind, place in the struct, domain, help), so that
+ * every mapping of a record (the command line's options and --help, HTTP
+ * queries, JSON, the store, a TSV log) is a loop over its fields rather
+ * than a list copied by hand.  Values pass as doubles: every kind's
+ * domain lies within the integers a double holds exactly (2^53).
+ */
+#ifndef TK_RECORD_H
+#define TK_RECORD_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "tk/error.h"
+#include "tk/tighten.h"
+
+typedef enum tk_field_kind {
+    TK_KIND_REAL,
+    TK_KIND_LONG,
+    TK_KIND_INT,
+    TK_KIND_SIZE,
+    TK_KIND_BOOL,
+    TK_KIND_SEED
+} tk_field_kind;
+
+typedef struct tk_field {
+    const char *field; /* the struct member */
+    const char *name;  /* as users give it; NULL: set in code only */
+    tk_field_kind kind;
+    size_t offset;
+    double dflt, min, max;
+    const char *help;
+} tk_field;
+
+/* The tables, in their order in tk/tighten.h. */
+extern const tk_field tk_option_fields[];
+extern const size_t tk_option_nfields;
+extern const tk_field tk_step_fields[];
+extern const size_t tk_step_nfields;
+
+/* The field called `name` (its user name), or NULL. */
+const tk_field *tk_field_find(const tk_field *table, size_t n, const char *name);
+
+/* The field's value in the record. */
+double tk_field_get(const tk_field *f, const void *record);
+
+/* Sets the field to x: TK_EINVAL, with a message naming the field and its
+ * domain, when x is not finite, not whole for a whole kind, or outside
+ * [min, max] (the record is then unchanged). */
+int tk_field_set(const tk_field *f, void *record, double x, tk_error *err);
+
+/* Sets the field from text: a number ("5", "1e-3"), or for a BOOL true,
+ * false, yes, no, 1 or 0.  Errors as tk_field_set, and for malformed
+ * text. */
+int tk_field_parse(const tk_field *f, void *record, const char *text, tk_error *err);
+
+/* Every option within its domain, and the options consistent with each
+ * other (re_resolve and snapshots exclude each other). */
+int tk_options_check(const tk_options *o, tk_error *err);
+
+/* Whether some stop criterion is set (steps, time, residual, change). */
+bool tk_options_have_stop(const tk_options *o);
+
+#endif
