@@ -18,6 +18,7 @@
  * configuration (48.208, 55.13).  The deformation's size is the largest
  * (from one diameter down by 0.7 each time) that keeps three quarters of
  * the thickness and the knot type. */
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -87,9 +88,14 @@ static int note(tk_run *r, tk_error *err)
     return rc;
 }
 
+int tk_escape_tries(const tk_run *r)
+{
+    return r->escape.tries_before + (int)r->escape.nlog;
+}
+
 static bool tries_left(const tk_run *r)
 {
-    return r->escape.nlog < (size_t)r->opt.escapes &&
+    return tk_escape_tries(r) < r->opt.escapes &&
            tk_schedule_spent(r) < 1.0 - ESCAPE_BUDGET_LEFT;
 }
 
@@ -221,6 +227,46 @@ int tk_escape_finish(tk_run *r, bool *restored, tk_error *err)
         rc = tk_schedule_restart(r, curve, false, r->escape.best_polish, err);
     *restored = rc == TK_OK;
     return rc;
+}
+
+/* splitmix64 adds its odd gamma to the state at every draw, so the
+ * stream's position is (state - seed) / gamma modulo 2^64, gamma's
+ * inverse found by Newton's iteration (each doubles the bits right). */
+#define GAMMA 0x9e3779b97f4a7c15ULL
+
+static uint64_t draws(const tk_run *r)
+{
+    uint64_t inv = GAMMA;
+    for (int k = 0; k < 6; k++)
+        inv *= 2 - GAMMA * inv;
+    assert(inv * GAMMA == 1);
+    return (r->escape.rng - (uint64_t)r->opt.seed) * inv;
+}
+
+void tk_escape_resume_point(const tk_run *r, tk_resume *out)
+{
+    out->escapes = tk_escape_tries(r);
+    out->draws = (long)draws(r);
+    out->best_polish = r->escape.best_polish;
+}
+
+const tk_curve *tk_run_best(const tk_run *r, tk_step_report *report)
+{
+    if (r->escape.best && report)
+        *report = r->escape.best_report;
+    return r->escape.best;
+}
+
+int tk_escape_resume(tk_run *r, const tk_resume *at, const tk_curve *best,
+                     const tk_step_report *best_report, tk_error *err)
+{
+    r->escape.tries_before = at->escapes;
+    r->escape.rng = (uint64_t)r->opt.seed + (uint64_t)at->draws * GAMMA;
+    if (!best)
+        return TK_OK;
+    r->escape.best_report = *best_report;
+    r->escape.best_polish = at->best_polish;
+    return tk_curve_copy(best, &r->escape.best, err);
 }
 
 const tk_escape *tk_run_escapes(const tk_run *r, size_t *count)

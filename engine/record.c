@@ -19,10 +19,15 @@
 #define STEP_ROW(fld, kind, dflt, lo, hi, nm, hlp)                                       \
     {#fld, nm, KIND_OF_##kind, offsetof(tk_step_report, fld), 0.0, lo, hi, hlp},
 
+#define RESUME_ROW(fld, kind, dflt, lo, hi, nm, hlp)                                     \
+    {#fld, nm, KIND_OF_##kind, offsetof(tk_resume, fld), (double)(dflt), lo, hi, hlp},
+
 const tk_field tk_option_fields[] = {TK_OPTION_FIELDS(OPTION_ROW)};
 const size_t tk_option_nfields = sizeof tk_option_fields / sizeof tk_option_fields[0];
 const tk_field tk_step_fields[] = {TK_STEP_FIELDS(STEP_ROW)};
 const size_t tk_step_nfields = sizeof tk_step_fields / sizeof tk_step_fields[0];
+const tk_field tk_resume_fields[] = {TK_RESUME_FIELDS(RESUME_ROW)};
+const size_t tk_resume_nfields = sizeof tk_resume_fields / sizeof tk_resume_fields[0];
 
 const tk_field *tk_field_find(const tk_field *table, size_t n, const char *name)
 {
@@ -53,13 +58,11 @@ static const char *label(const tk_field *f)
 
 int tk_field_set(const tk_field *f, void *record, double x, tk_error *err)
 {
-    if (!isfinite(x))
-        return tk_error_set(err, TK_EINVAL, "option '%s': must be a finite number", label(f));
-    if (f->kind != TK_KIND_REAL && x != floor(x))
+    if (f->kind != TK_KIND_REAL && isfinite(x) && x != floor(x))
         return tk_error_set(err, TK_EINVAL, "option '%s': must be a whole number, not %.17g",
                             label(f), x);
     if (!(x >= f->min && x <= f->max))
-        return tk_error_set(err, TK_EINVAL, "option '%s': must be from %.17g to %.17g, not %.17g",
+        return tk_error_set(err, TK_EINVAL, "option '%s': must be from %.6g to %.6g, not %.17g",
                             label(f), f->min, f->max, x);
     char *p = (char *)record + f->offset;
     switch (f->kind) {

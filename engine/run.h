@@ -127,6 +127,7 @@ struct tk_run {
 
     struct {             /* escape.c */
         uint64_t rng;        /* the deformations' random stream */
+        int tries_before;    /* escapes tried before the run was resumed */
         tk_curve *best;      /* the best final polygon so far, or NULL */
         tk_step_report best_report;
         tk_constraints best_set; /* the active set of its step: found
@@ -267,6 +268,14 @@ int tk_escape_before_step(tk_run *r, tk_error *err);
 /* The run has stopped: the best curve found becomes its result
  * (*restored when that is not the curve it stopped on). */
 int tk_escape_finish(tk_run *r, bool *restored, tk_error *err);
+/* Escapes tried, before a resume and since. */
+int tk_escape_tries(const tk_run *r);
+/* The escapes' part of the run's resume point. */
+void tk_escape_resume_point(const tk_run *r, tk_resume *out);
+/* A resumed run's escapes: tries before, the random stream's position
+ * and the best curve (copied). */
+int tk_escape_resume(tk_run *r, const tk_resume *at, const tk_curve *best,
+                     const tk_step_report *best_report, tk_error *err);
 void tk_escape_free(tk_run *r);
 
 /* ---- schedule.c ---- */
@@ -274,6 +283,10 @@ void tk_escape_free(tk_run *r);
 /* The run's curve from `start`: resampled (to the coarsest level's count)
  * and autoscaled as the options ask, and everything sized by it. */
 int tk_schedule_start(tk_run *r, const tk_curve *start, tk_error *err);
+/* A resumed run's schedule: its curve as it is, at the level, polishing
+ * and share of `at` (tk_schedule_resume_point's). */
+int tk_schedule_resume(tk_run *r, const tk_curve *curve, const tk_resume *at, tk_error *err);
+void tk_schedule_resume_point(const tk_run *r, tk_resume *out);
 /* Resizes the shared part and the rooms' vectors to the run's curve. */
 int tk_schedule_fit(tk_run *r, tk_error *err);
 /* The run's curve replaced by `curve` (taken over): with `coarse` the

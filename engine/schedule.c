@@ -114,6 +114,17 @@ int tk_schedule_fit(tk_run *r, tk_error *err)
     return TK_OK;
 }
 
+/* The levels a run with these options starts with (prepare_curve). */
+static int coarse_levels(const tk_options *o)
+{
+    int level = 0;
+    if (o->resolution > 0.0 && o->coarse_to_fine && o->snapshot_every == 0)
+        while (level < MAX_COARSE_LEVELS &&
+               ldexp(o->resolution, -(level + 1)) >= COARSEST_RESOLUTION)
+            level++;
+    return level;
+}
+
 /* The run's curve: a copy of the start, resampled to the resolution (of
  * the coarsest level) and autoscaled, or refused. */
 static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
@@ -137,12 +148,7 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
             return tk_error_set(err, TK_ELIMIT,
                                 "resolution %g at ropelength %.4g asks for %.0f vertices",
                                 r->opt.resolution, m.ropelength, want);
-        int level = 0;
-        if (r->opt.coarse_to_fine && r->opt.snapshot_every == 0)
-            while (level < MAX_COARSE_LEVELS &&
-                   ldexp(r->opt.resolution, -(level + 1)) >= COARSEST_RESOLUTION)
-                level++;
-        r->schedule.coarse_level = r->schedule.coarse_levels = level;
+        r->schedule.coarse_level = r->schedule.coarse_levels = coarse_levels(&r->opt);
         want = ceil(resolution_now(r) * m.ropelength);
         tk_curve *resampled = NULL;
         rc = tk_curve_resample_total(*curve, (size_t)want, &resampled, err);
@@ -188,6 +194,38 @@ int tk_schedule_start(tk_run *r, const tk_curve *start, tk_error *err)
     r->schedule.resolved_at = INFINITY;
     int rc = prepare_curve(r, start, err);
     return rc ? rc : tk_schedule_fit(r, err);
+}
+
+int tk_schedule_resume(tk_run *r, const tk_curve *curve, const tk_resume *at, tk_error *err)
+{
+    r->schedule.coarse_levels = coarse_levels(&r->opt);
+    if (at->coarse_level > r->schedule.coarse_levels)
+        return tk_error_set(err, TK_EINVAL,
+                            "the run resumes at coarse level %d, but its options have %d",
+                            at->coarse_level, r->schedule.coarse_levels);
+    r->schedule.coarse_level = at->coarse_level;
+    r->schedule.polish_level = at->polish_level;
+    r->schedule.share_from = at->share_from;
+    r->schedule.start_ropelength = at->start_ropelength;
+    r->schedule.resolved_at = at->resolved_at > 0.0 ? at->resolved_at : INFINITY;
+    tk_measure m;
+    int rc = tk_curve_copy(curve, &r->shared.curve, err);
+    if (!rc)
+        rc = measure(curve, &m, err);
+    if (!rc && m.thickness < r->tau * (1.0 - r->opt.overstep_tolerance))
+        rc = tk_error_set(err, TK_EINVAL,
+                          "the curve to resume is thinner (%.6g) than the tube diameter %.6g",
+                          m.thickness, r->tau);
+    return rc ? rc : tk_schedule_fit(r, err);
+}
+
+void tk_schedule_resume_point(const tk_run *r, tk_resume *out)
+{
+    out->start_ropelength = r->schedule.start_ropelength;
+    out->coarse_level = r->schedule.coarse_level;
+    out->polish_level = r->schedule.polish_level;
+    out->share_from = r->schedule.share_from;
+    out->resolved_at = isfinite(r->schedule.resolved_at) ? r->schedule.resolved_at : 0.0;
 }
 
 /* Resamples the run's curve to `count` vertices along its spline and

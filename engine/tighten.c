@@ -66,7 +66,7 @@ static int record(tk_run *r, tk_step_report *rep, tk_error *err)
     rep->minrad = m.minrad;
     rep->ropelength = m.ropelength;
     rep->vertices = r->shared.curve->nvert;
-    rep->escapes = (int)r->escape.nlog;
+    rep->escapes = tk_escape_tries(r);
     rep->seconds = tk_clock() - r->life.started;
     if (r->life.nhistory == r->life.history_capacity) {
         size_t cap = r->life.history_capacity ? 2 * r->life.history_capacity : 256;
@@ -111,13 +111,24 @@ static int figures(tk_run *r, tk_step_report *rep, tk_error *err)
     return rc ? rc : record(r, rep, err);
 }
 
-int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_error *err)
+/* A run from `start` (resampled and scaled as the options ask), or, with
+ * `at`, from a resumed run's curve as it is (tk_run_resume). */
+static int create(const tk_curve *start, const tk_options *opts, const tk_resume *at,
+                  const tk_curve *best, const tk_step_report *best_report,
+                  const tk_invariants *start_type, tk_run **out, tk_error *err)
 {
     *out = NULL;
     tk_options defaults = TK_OPTIONS_INIT;
     if (!opts)
         opts = &defaults;
     int rc = tk_options_check(opts, err);
+    for (size_t i = 0; !rc && at && i < tk_resume_nfields; i++) {
+        tk_resume copy = *at;
+        rc = tk_field_set(&tk_resume_fields[i], &copy, tk_field_get(&tk_resume_fields[i], at),
+                          err);
+    }
+    if (!rc && at && (!best != !best_report))
+        rc = tk_error_set(err, TK_EINVAL, "a best curve needs its figures, and they it");
     if (rc)
         return rc;
     tk_run *r = calloc(1, sizeof *r);
@@ -127,13 +138,18 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
     r->tau = 2.0 * opts->radius;
     r->min_radius = opts->lambda * opts->radius;
     atomic_init(&r->life.cancel, 0);
-    r->life.started = tk_clock();
+    /* a resumed run's clock goes on from the time it had spent */
+    r->life.started = tk_clock() - (at ? at->seconds : 0.0);
     r->type.checked_step = -1;
     r->escape.rng = opts->seed;
     rc = tk_nnls_new(&r->shared.nnls, err);
     if (!rc)
-        rc = tk_schedule_start(r, start, err);
-    if (!rc) {
+        rc = at ? tk_schedule_resume(r, start, at, err) : tk_schedule_start(r, start, err);
+    if (!rc && at)
+        rc = tk_escape_resume(r, at, best, best_report, err);
+    if (!rc && start_type) {
+        rc = tk_invariants_copy(start_type, &r->type.start, err);
+    } else if (!rc) {
         /* the start as given (tk_schedule_start validated it), before
          * resampling and scaling */
         double t0 = tk_clock();
@@ -144,13 +160,17 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
             tk_error_set(err, rc, "the knot or link type of the start cannot be told: %s",
                          why.message);
     }
-    if (!rc && r->shared.curve->nvert != start->nvert) {
+    if (!rc && (at || r->shared.curve->nvert != start->nvert)) {
         char when[64];
-        snprintf(when, sizeof when, "resampling to %zu vertices (resolution %g)",
-                 r->shared.curve->nvert, r->opt.resolution);
+        if (at)
+            snprintf(when, sizeof when, "resuming at step %ld", at->step);
+        else
+            snprintf(when, sizeof when, "resampling to %zu vertices (resolution %g)",
+                     r->shared.curve->nvert, r->opt.resolution);
         rc = tk_type_check(r, when, err);
     }
     tk_step_report rep = {0};
+    rep.step = at ? at->step : 0;
     rep.rcond = 1.0;
     rep.residual = NAN;
     if (!rc)
@@ -163,9 +183,32 @@ int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_e
         tk_run_free(&r);
         return rc;
     }
+    r->stepping.step_size = at ? at->step_size : 0.0;
     r->life.seconds = tk_clock() - r->life.started;
     *out = r;
     return TK_OK;
+}
+
+int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_error *err)
+{
+    return create(start, opts, NULL, NULL, NULL, NULL, out, err);
+}
+
+int tk_run_resume(const tk_curve *curve, const tk_options *opts, const tk_resume *at,
+                  const tk_curve *best, const tk_step_report *best_report,
+                  const tk_invariants *start_type, tk_run **out, tk_error *err)
+{
+    return create(curve, opts, at, best, best_report, start_type, out, err);
+}
+
+void tk_run_resume_point(const tk_run *r, tk_resume *out)
+{
+    memset(out, 0, sizeof *out);
+    out->step = r->life.latest.step;
+    out->seconds = r->life.latest.seconds;
+    out->step_size = r->stepping.step_size;
+    tk_schedule_resume_point(r, out);
+    tk_escape_resume_point(r, out);
 }
 
 void tk_run_set_progress(tk_run *r, tk_progress_fn fn, void *user)

@@ -15,6 +15,7 @@
 #include "support.h"
 #include "tk/generate.h"
 #include "tk/thickness.h"
+#include "tk/record.h"
 #include "tk/tighten.h"
 
 static bool quick(void)
@@ -368,7 +369,7 @@ START_TEST(radius_out_of_the_range_is_refused)
     for (size_t k = 0; k < sizeof refused / sizeof *refused; k++) {
         o.radius = refused[k];
         ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_EINVAL);
-        ck_assert_msg(strstr(err.message, "radius must be between 1e-30 and 1e+30"), "%s",
+        ck_assert_msg(strstr(err.message, "option 'radius': must be from 1e-30 to 1e+30"), "%s",
                       err.message);
         ck_assert(run == NULL);
     }
@@ -777,6 +778,131 @@ START_TEST(escapes_keep_the_best_and_repeat)
 }
 END_TEST
 
+/* A run stopped after `steps` and resumed from its resume point, curve,
+ * best curve and start type, as a process that ended would; returns the
+ * resumed run (the first is freed) and its resume point in *at. */
+static tk_run *interrupted(tk_run *first, long steps, tk_resume *at)
+{
+    tk_error err;
+    while (tk_run_latest(first)->step < steps)
+        ck_assert_msg(tk_run_step(first, &err) == TK_OK, "%s", err.message);
+    tk_run_resume_point(first, at);
+    /* the point is a record within its domains */
+    for (size_t i = 0; i < tk_resume_nfields; i++) {
+        tk_resume copy = *at;
+        ck_assert_int_eq(tk_field_set(&tk_resume_fields[i], &copy,
+                                      tk_field_get(&tk_resume_fields[i], at), NULL),
+                         TK_OK);
+    }
+    tk_step_report best_report;
+    const tk_curve *best = tk_run_best(first, &best_report);
+    tk_run *second = NULL;
+    ck_assert_msg(tk_run_resume(tk_run_curve(first), tk_run_options(first), at, best,
+                                best ? &best_report : NULL, tk_run_type_start(first), &second,
+                                &err) == TK_OK,
+                  "%s", err.message);
+    tk_run_free(&first);
+    return second;
+}
+
+/* Resumed mid-schedule, a coarse to fine run goes on at its level and
+ * within its budget: it ends on the final polygon at the step budget,
+ * its steps numbered on from where it stopped, as the run that went
+ * through ends. */
+START_TEST(a_resumed_run_goes_on_where_it_was)
+{
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 0, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 5;
+    o.max_steps = 400;
+    tk_run *through = NULL, *first = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &through, &err), TK_OK);
+    ck_assert_int_eq(tk_run_until(through, NULL, &err), TK_OK);
+    ck_assert_int_eq(tk_run_new(c, &o, &first, &err), TK_OK);
+    size_t coarse = tk_run_curve(first)->nvert;
+    tk_resume at;
+    tk_run *second = interrupted(first, 60, &at);
+    ck_assert_int_eq(at.step, 60);
+    ck_assert_int_eq(at.coarse_level, 1);
+    ck_assert(at.step_size > 0.0 && at.start_ropelength > 0.0);
+    const tk_step_report *start = tk_run_latest(second);
+    ck_assert_int_eq(start->step, 60);
+    ck_assert(start->seconds >= at.seconds);
+    ck_assert_uint_eq(tk_run_curve(second)->nvert, coarse);
+    ck_assert_int_eq(tk_run_until(second, NULL, &err), TK_OK);
+    const tk_step_report *end = tk_run_latest(second), *want = tk_run_latest(through);
+    printf("resumed at step 60: %.9f at step %ld, %zu vertices; straight through %.9f, %zu\n",
+           end->ropelength, end->step, end->vertices, want->ropelength, want->vertices);
+    ck_assert_int_eq(end->step, 400);
+    ck_assert_uint_eq(end->vertices, want->vertices);
+    ck_assert(end->vertices > coarse);
+    ck_assert(fabs(end->ropelength - want->ropelength) < 2e-3 * want->ropelength);
+    tk_run_free(&second);
+    tk_run_free(&through);
+    /* a curve of another type than the start's is refused */
+    tk_curve *unknot = NULL;
+    ck_assert_int_eq(tk_generate_torus(1, 1, 60, &unknot, NULL), TK_OK);
+    tk_curve_scale(unknot, 10.0);
+    tk_invariants trefoil = TK_INVARIANTS_INIT;
+    ck_assert_int_eq(tk_invariants_compute(c, &trefoil, NULL), TK_OK);
+    at.coarse_level = 0;
+    ck_assert_int_eq(tk_run_resume(unknot, &o, &at, NULL, NULL, &trefoil, &second, &err),
+                     TK_ETYPE);
+    /* and a level the options do not have */
+    at.coarse_level = 3;
+    ck_assert_int_eq(tk_run_resume(c, &o, &at, NULL, NULL, NULL, &second, &err), TK_EINVAL);
+    tk_invariants_free(&trefoil);
+    tk_curve_free(&unknot);
+    tk_curve_free(&c);
+}
+END_TEST
+
+/* Resumed during an escape, a run keeps its best curve, its tries and
+ * its random stream: it ends no worse than the best it had. */
+START_TEST(a_resumed_run_keeps_its_escapes)
+{
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_chain(2, 40, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.escapes = 2;
+    o.seed = 7;
+    o.max_steps = 1500;
+    tk_run *first = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &first, &err), TK_OK);
+    while (tk_run_latest(first)->escapes == 0 && tk_run_latest(first)->step < 1500)
+        ck_assert_int_eq(tk_run_step(first, &err), TK_OK);
+    ck_assert_int_eq(tk_run_latest(first)->escapes, 1);
+    tk_step_report best;
+    ck_assert_ptr_nonnull(tk_run_best(first, &best));
+    tk_resume at;
+    tk_run *second = interrupted(first, tk_run_latest(first)->step + 5, &at);
+    ck_assert_int_eq(at.escapes, 1);
+    ck_assert(at.draws > 0);
+    tk_step_report kept;
+    ck_assert_ptr_nonnull(tk_run_best(second, &kept));
+    ck_assert(kept.ropelength == best.ropelength);
+    ck_assert_int_eq(tk_run_latest(second)->escapes, 1);
+    /* the random stream's place reads back as it was set */
+    tk_resume again;
+    tk_run_resume_point(second, &again);
+    ck_assert_int_eq(again.draws, at.draws);
+    ck_assert_int_eq(tk_run_until(second, NULL, &err), TK_OK);
+    const tk_step_report *end = tk_run_latest(second);
+    printf("resumed during an escape: best %.9f, ended %.9f after %d escapes\n",
+           best.ropelength, end->ropelength, end->escapes);
+    ck_assert(end->ropelength <= best.ropelength * (1.0 + 1e-12));
+    ck_assert_int_le(end->escapes, 2);
+    ck_assert_int_eq(end->step, 1500);
+    tk_run_free(&second);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("tighten");
@@ -788,6 +914,8 @@ int main(void)
     tcase_add_test(tc, timing_accounts_for_the_run);
     tcase_add_test(tc, the_knot_type_is_checked);
     tcase_add_test(tc, escapes_keep_the_best_and_repeat);
+    tcase_add_test(tc, a_resumed_run_goes_on_where_it_was);
+    tcase_add_test(tc, a_resumed_run_keeps_its_escapes);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
     tcase_add_test(tc, cancellation_stops_within_one_step);

@@ -1,6 +1,7 @@
 /* tightknot: the fields of a record, by name.
  *
- * The run options and the step report are each written down once, as an
+ * The run options, the step report and a run's resume point are each
+ * written down once, as an
  * X-macro table (tk/tighten.h).  This module turns a table into field
  * descriptors (name, kind, place in the struct, domain, help), so that
  * every mapping of a record (the command line's options and --help, HTTP
@@ -40,6 +41,8 @@ extern const tk_field tk_option_fields[];
 extern const size_t tk_option_nfields;
 extern const tk_field tk_step_fields[];
 extern const size_t tk_step_nfields;
+extern const tk_field tk_resume_fields[];
+extern const size_t tk_resume_nfields;
 
 /* The field called `name` (its user name), or NULL. */
 const tk_field *tk_field_find(const tk_field *table, size_t n, const char *name);

@@ -237,6 +237,55 @@ typedef struct tk_run_timing {
 
 void tk_run_timing_get(const tk_run *r, tk_run_timing *out);
 
+/* Going on after the process ended.  A run's place in its schedule is a
+ * record (rows as for the options; a resumed run's budgets count from
+ * its first start, so the step and time it reached are part of it):
+ * with the run's curve, its best curve and the type of its start, that
+ * is what tk_run_resume needs to go on where it was: at the same coarse
+ * level and polishing, with the escapes it has left and the same random
+ * stream.  What it does not keep is the history before it (the windows
+ * that judge convergence begin again) and the warm start of the forces. */
+#define TK_RESUME_FIELDS(X)                                                                  \
+    X(step, LONG, 0, 0, 9e15, "step", "steps taken")                                        \
+    X(seconds, REAL, 0, 0, 1e12, "seconds", "wall time spent")                              \
+    X(start_ropelength, REAL, 0, 0, 1e300, "start_ropelength",                              \
+      "the ropelength of the input, before any resampling")                                  \
+    X(coarse_level, INT, 0, 0, 64, "coarse_level", "halvings of the vertex count still to "  \
+      "undo")                                                                                \
+    X(polish_level, INT, 0, 0, 1000, "polish_level", "times the ropelength has all but "     \
+      "stopped falling on this polygon")                                                     \
+    X(share_from, REAL, 0, 0, 1e9, "share_from",                                             \
+      "the part of the budget spent when the current schedule began")                        \
+    X(resolved_at, REAL, 0, 0, 1e300, "resolved_at",                                        \
+      "ropelength at the last re-resolution (0: none yet)")                                  \
+    X(step_size, REAL, 0, 0, 1e300, "step_size", "the last step's size")                     \
+    X(escapes, INT, 0, 0, 1000, "escapes", "escapes tried")                                 \
+    X(draws, LONG, 0, 0, 9e15, "draws", "numbers drawn from the escapes' random stream")    \
+    X(best_polish, INT, 0, 0, 1000, "best_polish", "the polishing level of the best curve")
+
+typedef struct tk_resume {
+    TK_RESUME_FIELDS(TK_FIELD_DECLARE)
+} tk_resume;
+
+/* The run's place, for tk_run_resume. */
+void tk_run_resume_point(const tk_run *r, tk_resume *out);
+
+/* The best curve on the final polygon so far (kept by the escapes) and
+ * its figures into *report; NULL when there is none (no escape has
+ * started: the run's curve is its best). */
+const tk_curve *tk_run_best(const tk_run *r, tk_step_report *report);
+
+/* A run that goes on from `curve` (the run's curve when `at` was taken),
+ * with the options it started with: the first history entry is that
+ * curve's figures at step at->step; steps and time count on from `at`.
+ * `best` and `best_report` (both or neither) are tk_run_best's;
+ * `start_type` the type of the first start (NULL: the curve's own, which
+ * then cannot catch a change before the resume).  TK_EINVAL when `at` is
+ * out of its domain or does not fit the options. */
+int tk_run_resume(const tk_curve *curve, const tk_options *opts, const tk_resume *at,
+                  const tk_curve *best, const tk_step_report *best_report,
+                  const tk_invariants *start_type, tk_run **out, tk_error *err);
+
 /* Snapshots: the vertex coordinates (3 * vertices doubles, same component
  * layout as tk_run_curve) every snapshot_every steps. */
 size_t tk_run_snapshot_count(const tk_run *r);
