@@ -64,12 +64,15 @@ int tk_json_record_set(const tk_field *table, size_t n, void *record, const json
         int rc = TK_OK;
         if (!f)
             rc = tk_error_set(err, TK_EINVAL, "unknown option '%.60s'", name);
-        else if (f->kind == TK_KIND_BOOL ? !json_is_boolean(value) : !json_is_number(value))
+        else if (f->kind == TK_KIND_BOOL ? !json_is_boolean(value)
+                                         : !json_is_number(value) &&
+                                               !(f->kind == TK_KIND_REAL && json_is_null(value)))
             rc = tk_error_set(err, TK_EINVAL, "option '%s': expected %s", name,
                               f->kind == TK_KIND_BOOL ? "true or false" : "a number");
         else
             rc = tk_field_set(f, record,
                               json_is_boolean(value) ? json_is_true(value)
+                              : json_is_null(value)  ? NAN
                                                      : json_number_value(value),
                               err);
         if (rc) {

@@ -29,7 +29,8 @@ json_t *tk_json_text(const char *s);
  * null. */
 json_t *tk_json_record(const tk_field *table, size_t n, const void *record);
 
-/* Sets the fields named in the JSON object obj.  TK_EINVAL when obj is not
+/* Sets the fields named in the JSON object obj (null for a REAL is NaN,
+ * which only a measurement takes).  TK_EINVAL when obj is not
  * an object, a name is unknown or a value is of the wrong type or out of
  * its domain; *bad (when not NULL) then points at the name (valid while
  * obj lives) and the record may have been changed by the names before. */

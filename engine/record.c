@@ -7,20 +7,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define KIND_OF_REAL TK_KIND_REAL
-#define KIND_OF_LONG TK_KIND_LONG
-#define KIND_OF_INT TK_KIND_INT
-#define KIND_OF_SIZE TK_KIND_SIZE
-#define KIND_OF_BOOL TK_KIND_BOOL
-#define KIND_OF_SEED TK_KIND_SEED
-
 #define OPTION_ROW(fld, kind, dflt, lo, hi, nm, hlp)                                     \
-    {#fld, nm, KIND_OF_##kind, offsetof(tk_options, fld), (double)(dflt), lo, hi, hlp},
+    TK_FIELD_ROW(tk_options, fld, fld, kind, dflt, lo, hi, nm, hlp),
+/* the step figures are measurements: any value, NaN included (a residual
+ * before the first step) */
 #define STEP_ROW(fld, kind, dflt, lo, hi, nm, hlp)                                       \
-    {#fld, nm, KIND_OF_##kind, offsetof(tk_step_report, fld), 0.0, lo, hi, hlp},
-
+    TK_FIELD_ROW(tk_step_report, fld, fld, kind, 0, -INFINITY, INFINITY, nm, hlp),
 #define RESUME_ROW(fld, kind, dflt, lo, hi, nm, hlp)                                     \
-    {#fld, nm, KIND_OF_##kind, offsetof(tk_resume, fld), (double)(dflt), lo, hi, hlp},
+    TK_FIELD_ROW(tk_resume, fld, fld, kind, dflt, lo, hi, nm, hlp),
 
 const tk_field tk_option_fields[] = {TK_OPTION_FIELDS(OPTION_ROW)};
 const size_t tk_option_nfields = sizeof tk_option_fields / sizeof tk_option_fields[0];
@@ -58,10 +52,11 @@ static const char *label(const tk_field *f)
 
 int tk_field_set(const tk_field *f, void *record, double x, tk_error *err)
 {
+    bool measured = f->min == -INFINITY && f->max == INFINITY;
     if (f->kind != TK_KIND_REAL && isfinite(x) && x != floor(x))
         return tk_error_set(err, TK_EINVAL, "option '%s': must be a whole number, not %.17g",
                             label(f), x);
-    if (!(x >= f->min && x <= f->max))
+    if (!measured && !(x >= f->min && x <= f->max))
         return tk_error_set(err, TK_EINVAL, "option '%s': must be from %.6g to %.6g, not %.17g",
                             label(f), f->min, f->max, x);
     char *p = (char *)record + f->offset;

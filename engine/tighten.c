@@ -163,7 +163,7 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
     if (!rc && (at || r->shared.curve->nvert != start->nvert)) {
         char when[64];
         if (at)
-            snprintf(when, sizeof when, "resuming at step %ld", at->step);
+            snprintf(when, sizeof when, "the curve resumed at step %ld", at->step);
         else
             snprintf(when, sizeof when, "resampling to %zu vertices (resolution %g)",
                      r->shared.curve->nvert, r->opt.resolution);

@@ -576,14 +576,15 @@ static mhd_result get_job_frames(tk_api *a, struct MHD_Connection *c, const tk_j
     if (per_frame > 0 && (size_t)limit * per_frame > FRAMES_COORDINATES_MAX)
         limit = (long)(FRAMES_COORDINATES_MAX / per_frame > 0 ? FRAMES_COORDINATES_MAX / per_frame
                                                                : 1);
-    long *steps = NULL;
-    double *xyz = NULL;
-    size_t n = 0, per = 0;
+    tk_store_frame *stored = NULL;
+    size_t n = 0;
     tk_error err;
-    if (tk_store_frames(a->store, job->id, (size_t)offset, (size_t)limit, &steps, &xyz, &n, &per,
-                        &err) != TK_OK)
+    if (tk_store_frames(a->store, job->id, (size_t)offset, (size_t)limit, &stored, &n, &err) !=
+        TK_OK)
         return send_problem(a, c, 500, "%s", err.message);
-    /* the component layout, from the stored curve (frames share it) */
+    /* the component layout, from the stored curve: a frame has its own
+     * vertex counts when the run resampled (coarse to fine,
+     * re-resolution), the curve's closed components always */
     json_t *comps = json_array();
     char *text = NULL;
     size_t len = 0;
@@ -594,19 +595,28 @@ static mhd_result get_job_frames(tk_api *a, struct MHD_Connection *c, const tk_j
             json_array_append_new(comps, json_pack("{s:I, s:b}", "vertices",
                                                    (json_int_t)tk_curve_comp_vertices(curve, k),
                                                    "closed", curve->closed[k]));
-    tk_curve_free(&curve);
     free(text);
     json_t *frames = json_array();
     for (size_t i = 0; i < n; i++) {
         json_t *coords = json_array();
-        for (size_t k = 0; k < per; k++)
-            json_array_append_new(coords, tk_json_number(xyz[i * per + k]));
-        json_array_append_new(frames, json_pack("{s:I, s:I, s:o}", "index",
-                                                (json_int_t)((size_t)offset + i), "step",
-                                                (json_int_t)steps[i], "coordinates", coords));
+        for (size_t k = 0; k < stored[i].count; k++)
+            json_array_append_new(coords, tk_json_number(stored[i].xyz[k]));
+        json_t *counts = stored[i].layout ? json_loads(stored[i].layout, 0, NULL) : NULL;
+        json_t *layout = json_array();
+        for (size_t k = 0; k < json_array_size(counts) && curve && k < curve->ncomp; k++)
+            json_array_append_new(layout,
+                                  json_pack("{s:O, s:b}", "vertices", json_array_get(counts, k),
+                                            "closed", curve->closed[k]));
+        json_decref(counts);
+        json_t *f = json_pack("{s:I, s:I, s:o}", "index", (json_int_t)((size_t)offset + i),
+                              "step", (json_int_t)stored[i].step, "coordinates", coords);
+        json_object_set_new(f, "components", json_array_size(layout) ? layout : json_copy(comps));
+        if (!json_array_size(layout))
+            json_decref(layout);
+        json_array_append_new(frames, f);
     }
-    free(steps);
-    free(xyz);
+    tk_curve_free(&curve);
+    tk_store_frames_free(stored, n);
     return send_json(a, c, 200,
                      json_pack("{s:I, s:I, s:I, s:I, s:o, s:o}", "id", (json_int_t)job->id,
                                "total", (json_int_t)job->frames, "offset", (json_int_t)offset,

@@ -171,20 +171,8 @@ static void history_load(history *h, const char *text, long resume)
         if (!(number_field(o, "step") < (double)resume))
             continue;
         tk_step_report r = {0};
-        r.step = (long)number_field(o, "step");
-        r.seconds = number_field(o, "seconds");
-        r.ropelength = number_field(o, "ropelength");
-        r.length = number_field(o, "length");
-        r.thickness = number_field(o, "thickness");
-        r.minrad = number_field(o, "minrad");
-        r.residual = number_field(o, "residual");
-        r.struts = (size_t)number_field(o, "struts");
-        r.kinks = (size_t)number_field(o, "kinks");
-        r.step_size = number_field(o, "step_size");
-        r.rcond = number_field(o, "rcond");
-        r.violation = number_field(o, "violation");
-        r.corrections = (int)number_field(o, "corrections");
-        r.vertices = (size_t)number_field(o, "vertices");
+        if (tk_json_record_set(tk_step_fields, tk_step_nfields, &r, o, NULL, NULL) != TK_OK)
+            continue; /* not an entry as written */
         h->items[h->count++] = r;
     }
     if (h->count >= 2)
@@ -199,21 +187,19 @@ static void history_load(history *h, const char *text, long resume)
 typedef struct job_run {
     worker_slot *slot;
     tk_run *run;
-    long step_offset;       /* steps taken before a restart */
-    double seconds_offset;
     history hist;
     double last_flush;      /* monotonic seconds */
     size_t frames_stored;   /* frames of the job in the store */
     long frame_after;       /* frames are due at multiples of `every` after
                                this step (the resume step: its frame, if
                                due, was stored with it) */
-    size_t per_frame;       /* doubles per frame */
     long last_step;         /* the last step reported (-1: none yet) */
-    long *pending_steps;    /* frames taken since the last write */
-    double *pending_xyz;
-    size_t pending, pending_cap;
-    tk_invariants input_type; /* a resumed job's: the type of its input
-                                 (the run's start is the stored curve) */
+    tk_store_frame *pending; /* frames taken since the last write */
+    size_t pending_count, pending_cap;
+    tk_invariants input_type; /* the type of the job's input (a resumed
+                                 run's start is the stored curve) */
+    tk_invariants refused;    /* the type of a stored curve the engine
+                                 refused to resume from (another type) */
 } job_run;
 
 /* The type the job started from: its input's. */
@@ -226,8 +212,30 @@ static const tk_invariants *start_type(const job_run *jr)
  * and the run's at its last check.  NULL when out of memory. */
 static char *invariants_text(const job_run *jr)
 {
+    const tk_invariants *result = jr->run ? tk_run_type_latest(jr->run) : &jr->refused;
     json_t *o = json_pack("{s:o, s:o}", "start", tk_json_invariants(start_type(jr)), "result",
-                          tk_json_invariants(tk_run_type_latest(jr->run)));
+                          tk_json_invariants(result));
+    char *text = tk_json_dump(o, false);
+    json_decref(o);
+    return text;
+}
+
+/* The run's resume point, best curve and its figures, as stored
+ * (TK_TEXT_RESUME).  NULL when out of memory. */
+static char *resume_text(const job_run *jr)
+{
+    tk_resume at;
+    tk_run_resume_point(jr->run, &at);
+    tk_step_report report;
+    const tk_curve *best = tk_run_best(jr->run, &report);
+    char *vect = NULL;
+    if (best && tk_vect_to_string(best, &vect, NULL, NULL) != TK_OK)
+        return NULL;
+    json_t *o = json_pack("{s:o, s:o, s:o}", "at",
+                          tk_json_record(tk_resume_fields, tk_resume_nfields, &at), "best",
+                          vect ? json_string(vect) : json_null(), "best_report",
+                          best ? tk_json_step(&report) : json_null());
+    free(vect);
     char *text = tk_json_dump(o, false);
     json_decref(o);
     return text;
@@ -236,13 +244,34 @@ static char *invariants_text(const job_run *jr)
 /* The frames of the job: stored and pending. */
 static size_t job_frames(const job_run *jr)
 {
-    return jr->frames_stored + jr->pending;
+    return jr->frames_stored + jr->pending_count;
+}
+
+static void drop_pending(job_run *jr)
+{
+    for (size_t i = 0; i < jr->pending_count; i++) {
+        free(jr->pending[i].xyz);
+        free(jr->pending[i].layout);
+    }
+    jr->pending_count = 0;
+}
+
+/* The curve's vertices per component as JSON text, or NULL. */
+static char *layout_text(const tk_curve *c)
+{
+    json_t *a = json_array();
+    for (size_t k = 0; a && k < c->ncomp; k++)
+        json_array_append_new(a, json_integer((json_int_t)tk_curve_comp_vertices(c, k)));
+    char *text = tk_json_dump(a, false);
+    json_decref(a);
+    return text;
 }
 
 /* Keeps the curve as a frame when the job's step is on the `every` grid.
- * The worker takes the frames itself (the engine's snapshots stay off):
- * they stay on the grid of the job's steps across a resume, and a long
- * run holds only the frames since the last write. */
+ * The worker takes the frames itself (the engine's snapshots stay off, so
+ * that the run keeps its schedule: a frame has the vertices of its step,
+ * coarse or re-resolved): they stay on the grid of the job's steps across
+ * a resume, and a long run holds only the frames since the last write. */
 static void take_frame(job_run *jr, long every, long step, bool again)
 {
     if (every <= 0 || step % every != 0)
@@ -251,10 +280,13 @@ static void take_frame(job_run *jr, long every, long step, bool again)
         /* the step reported again (the run's best curve put back): its
          * frame is taken again in its place, stored or not (frames are
          * written by their place in the job's sequence) */
-        if (jr->pending > 0)
-            jr->pending--;
-        else
+        if (jr->pending_count > 0) {
+            jr->pending_count--;
+            free(jr->pending[jr->pending_count].xyz);
+            free(jr->pending[jr->pending_count].layout);
+        } else {
             jr->frames_stored--;
+        }
         jr->frame_after = step - 1;
     }
     if (step <= jr->frame_after)
@@ -264,40 +296,44 @@ static void take_frame(job_run *jr, long every, long step, bool again)
     size_t most = TK_JOB_MAX_FRAME_BYTES / (per * sizeof(double));
     if (job_frames(jr) >= (most < TK_JOB_MAX_FRAMES ? most : TK_JOB_MAX_FRAMES))
         return; /* the job's share of the store is used up */
-    if (jr->pending == jr->pending_cap) {
+    if (jr->pending_count == jr->pending_cap) {
         size_t cap = jr->pending_cap ? 2 * jr->pending_cap : 8;
-        long *steps = realloc(jr->pending_steps, cap * sizeof *steps);
-        if (steps)
-            jr->pending_steps = steps;
-        double *xyz = steps ? realloc(jr->pending_xyz, cap * per * sizeof *xyz) : NULL;
-        if (xyz)
-            jr->pending_xyz = xyz;
-        if (!steps || !xyz)
+        tk_store_frame *grown = realloc(jr->pending, cap * sizeof *grown);
+        if (!grown)
             return; /* out of memory: this frame is left out */
+        jr->pending = grown;
         jr->pending_cap = cap;
     }
-    jr->per_frame = per;
-    memcpy(jr->pending_xyz + jr->pending * per, c->xyz, per * sizeof(double));
-    jr->pending_steps[jr->pending++] = step;
+    tk_store_frame f = {step, malloc(per * sizeof(double)), per, layout_text(c)};
+    if (!f.xyz || !f.layout) {
+        free(f.xyz);
+        free(f.layout);
+        return;
+    }
+    memcpy(f.xyz, c->xyz, per * sizeof(double));
+    jr->pending[jr->pending_count++] = f;
     jr->frame_after = step;
 }
 
 static double job_fraction(const tk_job *job)
 {
     double f = -1.0;
-    if (job->options.steps > 0)
-        f = (double)job->latest.step / (double)job->options.steps;
-    if (job->options.time > 0.0)
-        f = fmax(f, job->latest.seconds / job->options.time);
+    tk_options run;
+    tk_job_options_to_run(&job->options, &run);
+    if (run.max_steps > 0)
+        f = (double)job->latest.step / (double)run.max_steps;
+    if (run.max_seconds > 0.0)
+        f = fmax(f, job->latest.seconds / run.max_seconds);
     return f < 0.0 ? -1.0 : fmin(f, 1.0);
 }
 
-/* Writes the job's figures, curve, contacts, history, type and new frames
- * to the store, in one transaction: a restart finds them consistent. */
+/* Writes the job's figures, curve, contacts, history, type, resume point
+ * and new frames to the store, in one transaction: a restart finds them
+ * consistent. */
 static int flush_job(job_run *jr, const tk_job *job, tk_error *err)
 {
-    char *curve = NULL, *contacts = NULL, *hist = NULL, *type = NULL;
-    int rc = tk_vect_to_string(tk_run_curve(jr->run), &curve, NULL, err);
+    char *texts[TK_TEXTS] = {NULL};
+    int rc = tk_vect_to_string(tk_run_curve(jr->run), &texts[TK_TEXT_CURVE], NULL, err);
     const tk_curve *c = tk_run_curve(jr->run);
     size_t ns = 0, nk = 0;
     const tk_strut *struts = tk_run_struts(jr->run, &ns);
@@ -308,38 +344,28 @@ static int flush_job(job_run *jr, const tk_job *job, tk_error *err)
             json_object_set_new(o, "step", json_integer((json_int_t)job->latest.step));
             json_object_set_new(o, "thickness", tk_json_number(job->latest.thickness));
         }
-        contacts = tk_json_dump(o, false);
+        texts[TK_TEXT_CONTACTS] = tk_json_dump(o, false);
         json_decref(o);
-        hist = history_json(&jr->hist, &job->latest);
-        type = invariants_text(jr);
-        if (!contacts || !hist || !type)
+        texts[TK_TEXT_HISTORY] = history_json(&jr->hist, &job->latest);
+        texts[TK_TEXT_INVARIANTS] = invariants_text(jr);
+        texts[TK_TEXT_RESUME] = resume_text(jr);
+        if (!texts[TK_TEXT_CONTACTS] || !texts[TK_TEXT_HISTORY] ||
+            !texts[TK_TEXT_INVARIANTS] || !texts[TK_TEXT_RESUME])
             rc = tk_error_set(err, TK_ENOMEM, "out of memory writing job %lld",
                               (long long)job->id);
-    }
-    size_t nnew = jr->pending;
-    tk_store_frame *frames = nnew ? calloc(nnew, sizeof *frames) : NULL;
-    if (!rc && nnew && !frames)
-        rc = tk_error_set(err, TK_ENOMEM, "out of memory writing frames");
-    for (size_t i = 0; !rc && i < nnew; i++) {
-        frames[i].xyz = jr->pending_xyz + i * jr->per_frame;
-        frames[i].step = jr->pending_steps[i];
-        frames[i].count = jr->per_frame;
     }
     if (!rc) {
         tk_job copy = *job;
         copy.frames = job_frames(jr);
-        rc = tk_store_save(jr->slot->owner->store, &copy, curve, contacts, hist, type, frames,
-                           nnew, err);
+        rc = tk_store_save(jr->slot->owner->store, &copy, (const char *const *)texts,
+                           jr->pending, jr->pending_count, err);
         if (!rc) {
-            jr->frames_stored += nnew;
-            jr->pending = 0;
+            jr->frames_stored += jr->pending_count;
+            drop_pending(jr);
         }
     }
-    free(frames);
-    free(curve);
-    free(contacts);
-    free(hist);
-    free(type);
+    for (int k = 0; k < TK_TEXTS; k++)
+        free(texts[k]);
     return rc;
 }
 
@@ -396,8 +422,6 @@ static int on_step(const tk_step_report *s, void *user)
     worker_slot *slot = jr->slot;
     tk_jobs *j = slot->owner;
     tk_step_report r = *s;
-    r.step += jr->step_offset;
-    r.seconds += jr->seconds_offset;
     bool again = r.step == jr->last_step;
     jr->last_step = r.step;
     history_add(&jr->hist, &r);
@@ -429,87 +453,99 @@ static void fail_job(tk_jobs *j, tk_job *job, const char *message, const char *t
     job->state = TK_JOB_FAILED;
     job->finished = now_unix();
     snprintf(job->error, sizeof job->error, "%s", message);
-    tk_store_save(j->store, job, NULL, NULL, NULL, type, NULL, 0, NULL);
+    const char *texts[TK_TEXTS] = {NULL};
+    texts[TK_TEXT_INVARIANTS] = type;
+    tk_store_save(j->store, job, texts, NULL, 0, NULL);
 }
 
-/* Checks that a resumed job's stored curve has its input's type (TK_ETYPE
- * when not): the run compares its curve with its own start, and after a
- * crash between a change of type and the run's next check the changed
- * curve would be that start.  Sets jr->input_type. */
-static int check_resumed_type(tk_jobs *j, const tk_job *job, job_run *jr, tk_error *err)
+/* The job's input, parsed, into *out. */
+static int read_input(tk_jobs *j, const tk_job *job, tk_curve **out, tk_error *err)
 {
     char *text = NULL;
     size_t len = 0;
-    tk_curve *input = NULL;
     tk_vect_limits limits = TK_VECT_LIMITS_INIT;
     limits.max_vertices = j->cfg.max_vertices;
     int rc = tk_store_text(j->store, job->id, TK_TEXT_INPUT, &text, &len, err);
     if (!rc && !text)
         rc = tk_error_set(err, TK_EIO, "job %lld has no input", (long long)job->id);
     if (!rc)
-        rc = tk_vect_parse(text, len, &limits, &input, err);
+        rc = tk_vect_parse(text, len, &limits, out, err);
     free(text);
-    if (!rc)
-        rc = tk_invariants_compute(input, &jr->input_type, err);
-    tk_curve_free(&input);
-    tk_error why;
-    if (!rc && tk_invariants_compare(&jr->input_type, tk_run_type_start(jr->run), &why))
-        rc = tk_error_set(err, TK_ETYPE, "the curve stored at step %ld, resumed, has another "
-                                         "knot or link type than the input: %s",
-                          job->latest.step, why.message);
     return rc;
 }
 
-/* Sets up the engine run for a job: from its stored curve when it was
- * interrupted (no re-resolution, no rescaling, the step and time budgets
- * reduced by what was spent), else from its input. */
-static int setup_run(tk_jobs *j, tk_job *job, job_run *jr, tk_error *err)
+/* An interrupted job's run, from its stored curve and resume point (the
+ * engine goes on at its coarse level and polishing, with its escapes and
+ * best curve, and checks the curve against the input's type).  A job
+ * stored without a resume point (by an older daemon) goes on from its
+ * curve at its step, on the final polygon. */
+static int resume_run(tk_jobs *j, const tk_job *job, const tk_options *opts, job_run *jr,
+                      tk_error *err)
 {
-    char *text = NULL;
+    char *text = NULL, *resume = NULL;
     size_t len = 0;
-    int rc = tk_store_text(j->store, job->id, TK_TEXT_CURVE, &text, &len, err);
-    bool resume = !rc && text && job->latest.step > 0;
-    if (!rc && !resume) {
-        free(text);
-        text = NULL;
-        rc = tk_store_text(j->store, job->id, TK_TEXT_INPUT, &text, &len, err);
-        if (!rc && !text)
-            rc = tk_error_set(err, TK_EIO, "job %lld has no input", (long long)job->id);
-    }
-    tk_curve *curve = NULL;
     tk_vect_limits limits = TK_VECT_LIMITS_INIT;
     limits.max_vertices = j->cfg.max_vertices;
+    tk_curve *curve = NULL, *best = NULL;
+    int rc = tk_store_text(j->store, job->id, TK_TEXT_CURVE, &text, &len, err);
     if (!rc)
         rc = tk_vect_parse(text, len, &limits, &curve, err);
+    if (!rc)
+        rc = tk_store_text(j->store, job->id, TK_TEXT_RESUME, &resume, NULL, err);
+    tk_resume at = {.step = job->latest.step, .seconds = job->latest.seconds,
+                    .start_ropelength = job->latest.ropelength};
+    tk_step_report best_report = {0};
+    json_t *doc = !rc && resume ? json_loads(resume, 0, NULL) : NULL;
+    const char *vect = json_string_value(json_object_get(doc, "best"));
+    tk_error why;
+    if (!rc && resume &&
+        (!doc ||
+         tk_json_record_set(tk_resume_fields, tk_resume_nfields, &at,
+                            json_object_get(doc, "at"), NULL, &why) ||
+         (vect && (tk_vect_parse(vect, strlen(vect), &limits, &best, &why) ||
+                   tk_json_record_set(tk_step_fields, tk_step_nfields, &best_report,
+                                      json_object_get(doc, "best_report"), NULL, &why)))))
+        rc = tk_error_set(err, TK_EIO,
+                          "the stored resume point of job %lld does not read back: %.200s",
+                          (long long)job->id, doc ? why.message : "not JSON");
+    if (!rc)
+        rc = tk_run_resume(curve, opts, &at, best, best ? &best_report : NULL,
+                           &jr->input_type, &jr->run, err);
+    if (rc == TK_ETYPE) /* the job's result is what it was stored as */
+        tk_invariants_compute(curve, &jr->refused, NULL);
+    json_decref(doc);
     free(text);
+    free(resume);
+    tk_curve_free(&curve);
+    tk_curve_free(&best);
+    return rc;
+}
+
+/* Sets up the engine run for a job, with the options as the command line
+ * would run them: from its input, or, when it was interrupted, from where
+ * it was (resume_run).  A run knows its input's type either way. */
+static int setup_run(tk_jobs *j, tk_job *job, job_run *jr, tk_error *err)
+{
+    tk_curve *input = NULL;
+    int rc = read_input(j, job, &input, err);
+    if (!rc)
+        rc = tk_invariants_compute(input, &jr->input_type, err);
     tk_options opts;
     tk_job_options_to_run(&job->options, &opts);
     opts.snapshot_every = 0; /* frames are taken by the worker (take_frame) */
-    /* Frames and an interrupted job's stored curve keep one vertex count
-     * for the whole job: no coarse start. */
-    opts.coarse_to_fine = false;
+    bool resume = !rc && job->latest.step > 0;
     if (!rc && resume) {
-        jr->step_offset = job->latest.step;
-        jr->seconds_offset = job->latest.seconds;
-        opts.resolution = 0.0;
-        opts.autoscale = false;
-        if (opts.max_steps > 0)
-            opts.max_steps = opts.max_steps > jr->step_offset ? opts.max_steps - jr->step_offset
-                                                              : 1;
-        if (opts.max_seconds > 0.0)
-            opts.max_seconds = fmax(opts.max_seconds - jr->seconds_offset, 1e-3);
+        rc = resume_run(j, job, &opts, jr, err);
         char *hist = NULL;
-        if (tk_store_text(j->store, job->id, TK_TEXT_HISTORY, &hist, NULL, NULL) == TK_OK)
-            history_load(&jr->hist, hist, jr->step_offset);
+        if (!rc && tk_store_text(j->store, job->id, TK_TEXT_HISTORY, &hist, NULL, NULL) == TK_OK)
+            history_load(&jr->hist, hist, job->latest.step);
         free(hist);
         jr->frames_stored = job->frames;
-        jr->frame_after = jr->step_offset;
+        jr->frame_after = job->latest.step;
+    } else if (!rc) {
+        rc = tk_run_new(input, &opts, &jr->run, err);
     }
-    if (!rc)
-        rc = tk_run_new(curve, &opts, &jr->run, err);
-    tk_curve_free(&curve);
-    if (!rc && resume)
-        rc = check_resumed_type(j, job, jr, err);
+    tk_curve_free(&input);
     return rc;
 }
 
@@ -536,14 +572,15 @@ static void run_job(worker_slot *slot)
     }
     int rc = setup_run(j, &job, &jr, &err);
     if (rc) {
-        char *type = jr.run ? invariants_text(&jr) : NULL;
+        char *type = jr.run || jr.refused.ncomp ? invariants_text(&jr) : NULL;
         fail_job(j, &job, err.message, type);
         free(type);
         tk_run_free(&jr.run);
         tk_invariants_free(&jr.input_type);
+        tk_invariants_free(&jr.refused);
         free(jr.hist.items);
-        free(jr.pending_steps);
-        free(jr.pending_xyz);
+        drop_pending(&jr);
+        free(jr.pending);
         return;
     }
     job.state = TK_JOB_RUNNING;
@@ -598,8 +635,8 @@ static void run_job(worker_slot *slot)
     tk_run_free(&jr.run);
     tk_invariants_free(&jr.input_type);
     free(jr.hist.items);
-    free(jr.pending_steps);
-    free(jr.pending_xyz);
+    drop_pending(&jr);
+    free(jr.pending);
 }
 
 bool tk_worker_priority_parse(const char *text, tk_worker_priority *out)
@@ -759,20 +796,20 @@ int tk_job_prepare(const char *name, const tk_job_options *opts, const tk_curve 
         return tk_error_set(err, TK_ELIMIT, "the curve has %zu vertices; the limit is %zu",
                             curve->nvert, max_vertices);
     tk_run *probe = NULL;
-    if (opts->resolution > 0.0) {
+    if (run_opts.resolution > 0.0) {
         tk_options measure = run_opts;
         measure.resolution = 0.0;
         measure.autoscale = true;
         int rc = tk_run_new(curve, &measure, &probe, err);
         if (rc)
             return rc;
-        double wanted = ceil(opts->resolution * tk_run_latest(probe)->ropelength);
+        double wanted = ceil(run_opts.resolution * tk_run_latest(probe)->ropelength);
         tk_run_free(&probe);
         if (!(wanted <= (double)max_vertices))
             return tk_error_set(err, TK_ELIMIT,
                                 "option 'resolution': %g vertices per unit ropelength make %.0f "
                                 "vertices; the limit is %zu",
-                                opts->resolution, wanted, max_vertices);
+                                run_opts.resolution, wanted, max_vertices);
     }
     int rc = tk_run_new(curve, &run_opts, &probe, err);
     tk_run_free(&probe);
@@ -782,8 +819,8 @@ int tk_job_prepare(const char *name, const tk_job_options *opts, const tk_curve 
     snprintf(job->name, sizeof job->name, "%s", name);
     job->state = TK_JOB_QUEUED;
     job->options = *opts;
-    if (job->options.steps == 0 && job->options.time == 0.0 && job->options.residual == 0.0)
-        job->options.steps = TK_JOB_DEFAULT_STEPS;
+    /* the job shows the step budget it runs with */
+    job->options.run.max_steps = run_opts.max_steps;
     job->created = now_unix();
     job->fraction = -1.0;
     job->components = curve->ncomp;

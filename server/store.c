@@ -76,11 +76,12 @@ static const char schema[] =
     " step_size REAL, rcond REAL, violation REAL, corrections INTEGER, vertices INTEGER,"
     " components INTEGER, fraction REAL, stop_reason TEXT, error TEXT,"
     " frames INTEGER NOT NULL DEFAULT 0,"
-    " input TEXT NOT NULL, curve TEXT, contacts TEXT, history TEXT, invariants TEXT);"
+    " input TEXT NOT NULL, curve TEXT, contacts TEXT, history TEXT, invariants TEXT,"
+    " resume TEXT);"
     "CREATE INDEX IF NOT EXISTS jobs_by_state ON jobs (state, id);"
     "CREATE TABLE IF NOT EXISTS frames ("
     " job INTEGER NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,"
-    " seq INTEGER NOT NULL, step INTEGER NOT NULL, xyz BLOB NOT NULL,"
+    " seq INTEGER NOT NULL, step INTEGER NOT NULL, xyz BLOB NOT NULL, layout TEXT,"
     " PRIMARY KEY (job, seq));";
 
 #define JOB_COLUMNS                                                                        \
@@ -93,25 +94,28 @@ static int db_error(tk_store *s, tk_error *err, const char *what)
     return tk_error_set(err, TK_EIO, "job store: %s: %s", what, sqlite3_errmsg(s->db));
 }
 
-/* Columns added to the jobs table since its first version, each with its
- * declaration: a store written before gets them, so that the daemon takes
- * up the jobs an older one left. */
-static const char *const added_columns[][2] = {
-    {"invariants", "TEXT"},
+/* Columns added since the first version of the tables, each with its
+ * table and declaration: a store written before gets them, so that the
+ * daemon takes up the jobs an older one left. */
+static const char *const added_columns[][3] = {
+    {"jobs", "invariants", "TEXT"},
+    {"jobs", "resume", "TEXT"},
+    {"frames", "layout", "TEXT"},
 };
 
 static int add_columns(sqlite3 *db, char **message)
 {
     for (size_t i = 0; i < sizeof added_columns / sizeof added_columns[0]; i++) {
         char sql[160];
-        snprintf(sql, sizeof sql, "SELECT %s FROM jobs LIMIT 0", added_columns[i][0]);
+        snprintf(sql, sizeof sql, "SELECT %s FROM %s LIMIT 0", added_columns[i][1],
+                 added_columns[i][0]);
         sqlite3_stmt *st = NULL;
         bool there = sqlite3_prepare_v2(db, sql, -1, &st, NULL) == SQLITE_OK;
         sqlite3_finalize(st);
         if (there)
             continue;
-        snprintf(sql, sizeof sql, "ALTER TABLE jobs ADD COLUMN %s %s", added_columns[i][0],
-                 added_columns[i][1]);
+        snprintf(sql, sizeof sql, "ALTER TABLE %s ADD COLUMN %s %s", added_columns[i][0],
+                 added_columns[i][1], added_columns[i][2]);
         int rc = sqlite3_exec(db, sql, NULL, NULL, message);
         if (rc != SQLITE_OK)
             return rc;
@@ -426,6 +430,7 @@ static const char *text_column(tk_job_text which)
     case TK_TEXT_CONTACTS: return "contacts";
     case TK_TEXT_HISTORY: return "history";
     case TK_TEXT_INVARIANTS: return "invariants";
+    case TK_TEXT_RESUME: return "resume";
     default: return NULL;
     }
 }
@@ -451,23 +456,23 @@ static int add_frame_locked(tk_store *s, int64_t id, size_t seq, const tk_store_
 {
     sqlite3_stmt *st = NULL;
     int rc = sqlite3_prepare_v2(s->db,
-                                "INSERT OR REPLACE INTO frames (job, seq, step, xyz)"
-                                " VALUES (?, ?, ?, ?)",
+                                "INSERT OR REPLACE INTO frames (job, seq, step, xyz, layout)"
+                                " VALUES (?, ?, ?, ?, ?)",
                                 -1, &st, NULL);
     if (rc == SQLITE_OK) {
         sqlite3_bind_int64(st, 1, id);
         sqlite3_bind_int64(st, 2, (sqlite3_int64)seq);
         sqlite3_bind_int64(st, 3, f->step);
         sqlite3_bind_blob64(st, 4, f->xyz, f->count * sizeof(double), SQLITE_STATIC);
+        bind_text_or_null(st, 5, f->layout);
         rc = sqlite3_step(st);
     }
     sqlite3_finalize(st);
     return rc == SQLITE_DONE ? TK_OK : db_error(s, err, "storing a frame");
 }
 
-int tk_store_save(tk_store *s, const tk_job *job, const char *curve, const char *contacts,
-                  const char *history, const char *invariants, const tk_store_frame *frames,
-                  size_t nframes, tk_error *err)
+int tk_store_save(tk_store *s, const tk_job *job, const char *const *texts,
+                  const tk_store_frame *frames, size_t nframes, tk_error *err)
 {
     pthread_mutex_lock(&s->lock);
     int status = TK_OK;
@@ -477,14 +482,9 @@ int tk_store_save(tk_store *s, const tk_job *job, const char *curve, const char 
         return status;
     }
     status = update_locked(s, job, err);
-    if (!status && curve)
-        status = set_text_locked(s, job->id, TK_TEXT_CURVE, curve, err);
-    if (!status && contacts)
-        status = set_text_locked(s, job->id, TK_TEXT_CONTACTS, contacts, err);
-    if (!status && history)
-        status = set_text_locked(s, job->id, TK_TEXT_HISTORY, history, err);
-    if (!status && invariants)
-        status = set_text_locked(s, job->id, TK_TEXT_INVARIANTS, invariants, err);
+    for (int k = 0; !status && texts && k < TK_TEXTS; k++)
+        if (texts[k])
+            status = set_text_locked(s, job->id, (tk_job_text)k, texts[k], err);
     /* the frames are the last nframes of job->frames */
     for (size_t i = 0; !status && i < nframes; i++)
         status = add_frame_locked(s, job->id, job->frames - nframes + i, &frames[i], err);
@@ -616,50 +616,39 @@ int tk_store_text(tk_store *s, int64_t id, tk_job_text which, char **out, size_t
     return status;
 }
 
-int tk_store_frames(tk_store *s, int64_t id, size_t offset, size_t limit, long **steps,
-                    double **xyz, size_t *n, size_t *per_frame, tk_error *err)
+int tk_store_frames(tk_store *s, int64_t id, size_t offset, size_t limit, tk_store_frame **out,
+                    size_t *n, tk_error *err)
 {
-    *steps = NULL;
-    *xyz = NULL;
     *n = 0;
-    *per_frame = 0;
-    long *st_out = limit ? calloc(limit, sizeof *st_out) : NULL;
-    if (limit && !st_out)
+    *out = limit ? calloc(limit, sizeof **out) : NULL;
+    if (limit && !*out)
         return tk_error_set(err, TK_ENOMEM, "out of memory");
-    double *coords = NULL;
     pthread_mutex_lock(&s->lock);
     sqlite3_stmt *st = NULL;
     int status = TK_OK;
     int rc = sqlite3_prepare_v2(s->db,
-                                "SELECT step, xyz FROM frames WHERE job = ? AND seq >= ?"
+                                "SELECT step, xyz, layout FROM frames WHERE job = ? AND seq >= ?"
                                 " ORDER BY seq LIMIT ?",
                                 -1, &st, NULL);
     if (rc == SQLITE_OK) {
         sqlite3_bind_int64(st, 1, id);
         sqlite3_bind_int64(st, 2, (sqlite3_int64)offset);
         sqlite3_bind_int64(st, 3, (sqlite3_int64)limit);
-        while (!status && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+        while (!status && *n < limit && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+            tk_store_frame *f = &(*out)[*n];
             size_t bytes = (size_t)sqlite3_column_bytes(st, 1);
-            size_t count = bytes / sizeof(double);
-            if (*n == 0) {
-                *per_frame = count;
-                coords = malloc(limit * (count ? count : 1) * sizeof *coords);
-                if (!coords) {
-                    status = tk_error_set(err, TK_ENOMEM, "out of memory for frames");
-                    break;
-                }
-            }
-            if (count != *per_frame) {
-                status = tk_error_set(err, TK_EIO, "job store: frames of job %lld differ in size",
-                                      (long long)id);
-                break;
-            }
-            st_out[*n] = (long)sqlite3_column_int64(st, 0);
-            if (count)
-                memcpy(coords + *n * count, sqlite3_column_blob(st, 1), bytes);
+            const unsigned char *layout = sqlite3_column_text(st, 2);
+            f->step = (long)sqlite3_column_int64(st, 0);
+            f->count = bytes / sizeof(double);
+            f->xyz = malloc(bytes ? bytes : 1);
+            f->layout = layout ? strdup((const char *)layout) : NULL;
             (*n)++;
+            if (!f->xyz || (layout && !f->layout))
+                status = tk_error_set(err, TK_ENOMEM, "out of memory for frames");
+            else if (bytes)
+                memcpy(f->xyz, sqlite3_column_blob(st, 1), bytes);
         }
-        if (!status && rc != SQLITE_DONE)
+        if (!status && rc != SQLITE_DONE && rc != SQLITE_ROW)
             status = db_error(s, err, "reading frames");
     } else {
         status = db_error(s, err, "reading frames");
@@ -667,14 +656,20 @@ int tk_store_frames(tk_store *s, int64_t id, size_t offset, size_t limit, long *
     sqlite3_finalize(st);
     pthread_mutex_unlock(&s->lock);
     if (status) {
-        free(st_out);
-        free(coords);
+        tk_store_frames_free(*out, *n);
+        *out = NULL;
         *n = 0;
-        return status;
     }
-    *steps = st_out;
-    *xyz = coords;
-    return TK_OK;
+    return status;
+}
+
+void tk_store_frames_free(tk_store_frame *frames, size_t n)
+{
+    for (size_t i = 0; frames && i < n; i++) {
+        free(frames[i].xyz);
+        free(frames[i].layout);
+    }
+    free(frames);
 }
 
 int tk_store_unfinished(tk_store *s, int64_t **ids, size_t *n, tk_error *err)

@@ -50,8 +50,8 @@ static int64_t add_job(tk_store *s, const char *name, tk_job_state state)
     snprintf(j.name, sizeof j.name, "%s", name);
     j.state = state;
     tk_job_options o = TK_JOB_OPTIONS_INIT;
-    o.steps = 77;
-    o.resolution = 5;
+    o.run.max_steps = 77;
+    o.run.resolution = 5;
     j.options = o;
     j.created = 1.7e9;
     tk_error err;
@@ -92,15 +92,16 @@ START_TEST(a_job_reads_back_after_reopening)
     for (int f = 0; f < 2; f++)
         for (int k = 0; k < 9; k++)
             xyz[f][k] = sin(1.0 + f * 9 + k) / 3.0; /* not short decimals */
-    tk_store_frame frames[2] = {{10, xyz[0], 9}, {20, xyz[1], 9}};
+    /* frames of two layouts: one stored before frames had their own */
+    tk_store_frame frames[2] = {{10, xyz[0], 9, NULL}, {20, xyz[1], 6, (char *)"[2]"}};
     j.frames = 2;
     char *none = (char *)"not read";
     ck_assert_int_eq(tk_store_text(s, id, TK_TEXT_INVARIANTS, &none, NULL, &err), TK_OK);
     ck_assert_ptr_null(none); /* before the run starts */
     const char *type = "{\"start\":{\"determinants\":[3]},\"result\":null}";
-    ck_assert_int_eq(tk_store_save(s, &j, "VECT curve", "{\"struts\":[]}", "[]", type, frames, 2,
-                                   &err),
-                     TK_OK);
+    const char *texts[TK_TEXTS] = {NULL, "VECT curve", "{\"struts\":[]}", "[]", type,
+                                   "{\"at\":{}}"};
+    ck_assert_int_eq(tk_store_save(s, &j, texts, frames, 2, &err), TK_OK);
     tk_store_close(&s);
 
     s = open_store();
@@ -108,8 +109,8 @@ START_TEST(a_job_reads_back_after_reopening)
     ck_assert_int_eq(tk_store_get(s, id, &back, &err), TK_OK);
     ck_assert_str_eq(back.name, "trefoil");
     ck_assert_int_eq(back.state, TK_JOB_DONE);
-    ck_assert_int_eq(back.options.steps, 77);
-    ck_assert(back.options.resolution == 5.0);
+    ck_assert_int_eq(back.options.run.max_steps, 77);
+    ck_assert(back.options.run.resolution == 5.0);
     ck_assert(back.latest.ropelength == 32.7523560914);
     ck_assert(back.latest.length == 16.3761780457);
     ck_assert(back.started == 1.7e9 + 1.0 && back.finished == 1.7e9 + 2.5);
@@ -129,16 +130,27 @@ START_TEST(a_job_reads_back_after_reopening)
     ck_assert_int_eq(tk_store_text(s, id, TK_TEXT_INVARIANTS, &text, NULL, &err), TK_OK);
     ck_assert_str_eq(text, type);
     free(text);
-    long *steps = NULL;
-    double *coords = NULL;
-    size_t n = 0, per = 0;
-    ck_assert_int_eq(tk_store_frames(s, id, 1, 5, &steps, &coords, &n, &per, &err), TK_OK);
+    ck_assert_int_eq(tk_store_text(s, id, TK_TEXT_RESUME, &text, NULL, &err), TK_OK);
+    ck_assert_str_eq(text, "{\"at\":{}}");
+    free(text);
+    tk_store_frame *back_frames = NULL;
+    size_t n = 0;
+    ck_assert_int_eq(tk_store_frames(s, id, 0, 5, &back_frames, &n, &err), TK_OK);
+    ck_assert_uint_eq(n, 2);
+    ck_assert_int_eq(back_frames[0].step, 10);
+    ck_assert_uint_eq(back_frames[0].count, 9);
+    ck_assert_ptr_null(back_frames[0].layout);
+    ck_assert(memcmp(back_frames[0].xyz, xyz[0], sizeof xyz[0]) == 0);
+    ck_assert_int_eq(back_frames[1].step, 20);
+    ck_assert_uint_eq(back_frames[1].count, 6);
+    ck_assert_str_eq(back_frames[1].layout, "[2]");
+    ck_assert(memcmp(back_frames[1].xyz, xyz[1], 6 * sizeof(double)) == 0);
+    tk_store_frames_free(back_frames, n);
+    /* a page from the middle */
+    ck_assert_int_eq(tk_store_frames(s, id, 1, 5, &back_frames, &n, &err), TK_OK);
     ck_assert_uint_eq(n, 1);
-    ck_assert_uint_eq(per, 9);
-    ck_assert_int_eq(steps[0], 20);
-    ck_assert(memcmp(coords, xyz[1], sizeof xyz[1]) == 0);
-    free(steps);
-    free(coords);
+    ck_assert_int_eq(back_frames[0].step, 20);
+    tk_store_frames_free(back_frames, n);
     tk_store_close(&s);
 }
 END_TEST
@@ -222,9 +234,10 @@ START_TEST(an_unwritable_path_is_an_error)
 }
 END_TEST
 
-/* The jobs table as the first version of the store made it, with one
- * finished job: opened by this one, the job reads back, has no type
- * stored, and takes one. */
+/* The tables as the first version of the store made them, with one
+ * finished job and its frame: opened by this one, the job reads back,
+ * has no type or resume point stored, and takes one; its frame has no
+ * layout of its own (it has the job's curve's). */
 START_TEST(an_older_store_gets_the_invariants_column)
 {
     sqlite3 *db = NULL;
@@ -242,7 +255,13 @@ START_TEST(an_older_store_gets_the_invariants_column)
         " frames INTEGER NOT NULL DEFAULT 0,"
         " input TEXT NOT NULL, curve TEXT, contacts TEXT, history TEXT);"
         "INSERT INTO jobs (name, state, options, created, step, ropelength, input, curve)"
-        " VALUES ('old', 'done', '{\"steps\": 5}', 1.7e9, 5, 33.5, 'VECT in', 'VECT out');";
+        " VALUES ('old', 'done', '{\"steps\": 5}', 1.7e9, 5, 33.5, 'VECT in', 'VECT out');"
+        "CREATE TABLE frames ("
+        " job INTEGER NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,"
+        " seq INTEGER NOT NULL, step INTEGER NOT NULL, xyz BLOB NOT NULL,"
+        " PRIMARY KEY (job, seq));"
+        "INSERT INTO frames VALUES (1, 0, 0,"
+        " x'000000000000F03F000000000000F03F000000000000F03F');";
     char *message = NULL;
     ck_assert_msg(sqlite3_exec(db, old, NULL, NULL, &message) == SQLITE_OK, "%s", message);
     sqlite3_close(db);
@@ -258,8 +277,19 @@ START_TEST(an_older_store_gets_the_invariants_column)
     char *text = (char *)"not read";
     ck_assert_int_eq(tk_store_text(s, 1, TK_TEXT_INVARIANTS, &text, NULL, &err), TK_OK);
     ck_assert_ptr_null(text);
-    ck_assert_int_eq(tk_store_save(s, &j, NULL, NULL, NULL, "{\"start\":null}", NULL, 0, &err),
-                     TK_OK);
+    ck_assert_int_eq(tk_store_text(s, 1, TK_TEXT_RESUME, &text, NULL, &err), TK_OK);
+    ck_assert_ptr_null(text);
+    tk_store_frame *frames = NULL;
+    size_t n = 0;
+    ck_assert_int_eq(tk_store_frames(s, 1, 0, 10, &frames, &n, &err), TK_OK);
+    ck_assert_uint_eq(n, 1);
+    ck_assert_uint_eq(frames[0].count, 3);
+    ck_assert(frames[0].xyz[0] == 1.0 && frames[0].xyz[2] == 1.0);
+    ck_assert_ptr_null(frames[0].layout);
+    tk_store_frames_free(frames, n);
+    const char *texts[TK_TEXTS] = {NULL};
+    texts[TK_TEXT_INVARIANTS] = "{\"start\":null}";
+    ck_assert_int_eq(tk_store_save(s, &j, texts, NULL, 0, &err), TK_OK);
     tk_store_close(&s);
     /* opening it again adds nothing more */
     s = open_store();

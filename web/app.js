@@ -628,7 +628,8 @@ async function loadFrames(job, live) {
         const page = await api.frames(job.id, offset, FRAME_PAGE);
         if (!live()) return;
         total = page.total;
-        for (const f of page.frames) state.frames.push({ step: f.step, comps: splitFlat(f.coordinates, page.components) });
+        // a frame has its own vertex counts (coarse to fine, re-resolution)
+        for (const f of page.frames) state.frames.push({ step: f.step, comps: splitFlat(f.coordinates, f.components || page.components) });
         if (!page.frames.length) break;
         offset += page.frames.length;
         $('replay-label').textContent = `loading frames ${offset} / ${total}`;

@@ -36,6 +36,11 @@ typedef struct tk_field {
     const char *help;
 } tk_field;
 
+/* A row of a table for the struct `type` from an X-macro row (tk/tighten.h),
+ * the member `fld` reached by `path` (fld, or outer.fld). */
+#define TK_FIELD_ROW(type, path, fld, kind, dflt, lo, hi, nm, hlp)                         \
+    {#fld, nm, TK_KIND_##kind, offsetof(type, path), (double)(dflt), lo, hi, hlp}
+
 /* The tables, in their order in tk/tighten.h. */
 extern const tk_field tk_option_fields[];
 extern const size_t tk_option_nfields;
@@ -51,8 +56,9 @@ const tk_field *tk_field_find(const tk_field *table, size_t n, const char *name)
 double tk_field_get(const tk_field *f, const void *record);
 
 /* Sets the field to x: TK_EINVAL, with a message naming the field and its
- * domain, when x is not finite, not whole for a whole kind, or outside
- * [min, max] (the record is then unchanged). */
+ * domain, when x is not whole for a whole kind, or outside [min, max] (not
+ * finite included; the record is then unchanged).  A field whose domain
+ * is (-inf, inf) is a measurement and takes any value, NaN too. */
 int tk_field_set(const tk_field *f, void *record, double x, tk_error *err);
 
 /* Sets the field from text: a number ("5", "1e-3"), or for a BOOL true,

@@ -58,10 +58,16 @@ typedef enum tk_job_text {
     TK_TEXT_CURVE,     /* the latest curve as VECT (NULL before the run starts) */
     TK_TEXT_CONTACTS,  /* struts and kinks JSON (tk_json_contacts) */
     TK_TEXT_HISTORY,   /* decimated per-step figures, a JSON array */
-    TK_TEXT_INVARIANTS /* {"start", "result"}: the knot or link type of the
+    TK_TEXT_INVARIANTS, /* {"start", "result"}: the knot or link type of the
                           input and of the run's curve at its last check
                           (tk_json_invariants each); NULL until the run
                           has started */
+    TK_TEXT_RESUME,     /* {"at": the run's resume point (tk/tighten.h's
+                           TK_RESUME_FIELDS), "best": its best curve as
+                           VECT or null, "best_report": that curve's step
+                           figures or null}; NULL until the run has
+                           started */
+    TK_TEXTS
 } tk_job_text;
 
 typedef struct tk_store tk_store;
@@ -86,26 +92,31 @@ int tk_store_list(tk_store *s, bool filter, tk_job_state state, size_t offset, s
 /* Stores the state, timestamps, figures, stop reason and error of job. */
 int tk_store_update(tk_store *s, const tk_job *job, tk_error *err);
 
-/* Stores the job (as tk_store_update) and, in the same transaction, any
- * non-NULL texts (curve, contacts, history, invariants) and frames. */
+/* A frame of a job: its step, the curve's coordinates and, as JSON, its
+ * vertices per component (frames differ in them when the run resampled;
+ * NULL: those of the job's stored curve, as frames stored before). */
 typedef struct tk_store_frame {
     long step;
-    const double *xyz;
-    size_t count; /* doubles */
+    double *xyz;
+    size_t count;  /* doubles */
+    char *layout;  /* JSON array of vertex counts, or NULL */
 } tk_store_frame;
 
-int tk_store_save(tk_store *s, const tk_job *job, const char *curve, const char *contacts,
-                  const char *history, const char *invariants, const tk_store_frame *frames,
-                  size_t nframes, tk_error *err);
+/* Stores the job (as tk_store_update) and, in the same transaction, the
+ * texts that are not NULL (texts[k] for tk_job_text k; texts may be
+ * NULL) and the frames, which are the last nframes of job->frames. */
+int tk_store_save(tk_store *s, const tk_job *job, const char *const *texts,
+                  const tk_store_frame *frames, size_t nframes, tk_error *err);
 
 /* Reads one text; *out is NULL when it was never stored (free with free()). */
 int tk_store_text(tk_store *s, int64_t id, tk_job_text which, char **out, size_t *len,
                   tk_error *err);
 
-/* Frames [offset, offset + limit) of a job: *steps and *xyz (count doubles
- * per frame) newly allocated; *n frames returned. */
-int tk_store_frames(tk_store *s, int64_t id, size_t offset, size_t limit, long **steps,
-                    double **xyz, size_t *n, size_t *per_frame, tk_error *err);
+/* Frames [offset, offset + limit) of a job into *out (*n of them; free
+ * with tk_store_frames_free). */
+int tk_store_frames(tk_store *s, int64_t id, size_t offset, size_t limit, tk_store_frame **out,
+                    size_t *n, tk_error *err);
+void tk_store_frames_free(tk_store_frame *frames, size_t n);
 
 /* Ids of queued and running jobs, oldest first (to take up after a
  * restart). */

@@ -20,9 +20,13 @@
  * padding, so not memcmp). */
 static inline int fuzz_options_equal(const tk_job_options *a, const tk_job_options *b)
 {
-    return a->resolution == b->resolution && a->steps == b->steps && a->time == b->time &&
-           a->residual == b->residual && a->radius == b->radius && a->lambda == b->lambda &&
-           a->autoscale == b->autoscale && a->every == b->every;
+    for (size_t i = 0; i < tk_job_option_nfields; i++) {
+        double x = tk_field_get(&tk_job_option_fields[i], a);
+        double y = tk_field_get(&tk_job_option_fields[i], b);
+        if (!(x == y || (x != x && y != y)))
+            return 0;
+    }
+    return 1;
 }
 
 #endif

@@ -58,15 +58,18 @@ static int from_json(tk_job_options *o, const char *text, size_t len)
     return rc;
 }
 
+/* Every field within its table's domain, checked independently of the
+ * code that set it. */
 static void check_domains(const tk_job_options *o)
 {
-    CHECK(o->resolution >= 0.0 && o->resolution <= 1e4);
-    CHECK(o->steps >= 0 && o->steps <= 1000000000L);
-    CHECK(o->every >= 0 && o->every <= 1000000000L);
-    CHECK(o->time >= 0.0 && isfinite(o->time));
-    CHECK(o->residual >= 0.0 && isfinite(o->residual));
-    CHECK(o->radius >= 1e-30 && o->radius <= 1e30);
-    CHECK(o->lambda > 0.0 && isfinite(o->lambda));
+    for (size_t i = 0; i < tk_job_option_nfields; i++) {
+        const tk_field *f = &tk_job_option_fields[i];
+        double x = tk_field_get(f, o);
+        CHECK(x >= f->min && x <= f->max);
+        CHECK(f->kind == TK_KIND_REAL || x == floor(x));
+    }
+    CHECK(o->run.radius >= 1e-30 && o->run.radius <= 1e30);
+    CHECK(o->run.lambda > 0.0 && isfinite(o->run.lambda));
 }
 
 static void check_round_trip(const tk_job_options *o)
@@ -74,7 +77,8 @@ static void check_round_trip(const tk_job_options *o)
     json_t *j = tk_job_options_to_json(o);
     CHECK(j);
     tk_job_options back = TK_JOB_OPTIONS_INIT;
-    back.autoscale = !o->autoscale; /* so that the flag must be read back */
+    back.run.autoscale = !o->run.autoscale; /* so that the flags must be read back */
+    back.run.coarse_to_fine = !o->run.coarse_to_fine;
     tk_error err;
     CHECK(tk_job_options_from_json(&back, j, NULL, &err) == TK_OK);
     CHECK(fuzz_options_equal(&back, o));
@@ -85,7 +89,7 @@ static void check_round_trip(const tk_job_options *o)
  * started, or refused with a clean error. */
 static void check_run(const tk_job_options *o)
 {
-    if (o->resolution > 20.0)
+    if (o->run.resolution > 20.0)
         return; /* thousands of vertices: too slow for a fuzz input */
     tk_curve *c = NULL;
     CHECK(tk_generate_torus(2, 3, 24, &c, NULL) == TK_OK);

@@ -5,8 +5,10 @@
 import assert from 'node:assert/strict';
 import { describe, test } from 'node:test';
 
+import { join } from 'node:path';
+
 import {
-    generate, sleep, startDaemon, submit, tempDir, tighten, waitFinal, waitJob,
+    CATALOGUE, generate, sleep, startDaemon, submit, tempDir, tighten, waitFinal, waitJob,
 } from './lib.mjs';
 
 // The history of a resumed job: one run of increasing steps from 0 to the
@@ -40,7 +42,9 @@ async function assertResumedFrames(d, job) {
     assert.equal(frames[0].step, 0);
     for (let i = 1; i < frames.length; i++)
         assert.ok(frames[i].step > frames[i - 1].step, `frame steps increase at ${i}: ${frames[i - 1].step}, ${frames[i].step}`);
-    for (const f of frames) assert.equal(f.coordinates.length, 3 * job.vertices);
+    // a frame has the vertices of its step (fewer on a coarse level)
+    for (const f of frames)
+        assert.equal(f.coordinates.length, 3 * f.components.reduce((n, c) => n + c.vertices, 0));
     // on the grid of the job's steps, across the restart: every multiple of
     // options.every up to the last step, each once
     const every = job.options.every;
@@ -53,6 +57,9 @@ describe('kill -9 and restart on the same store', () => {
         const dir = tempDir('kill');
         const knot = await generate(dir, 'torus23.vect', ['torus', '2', '3', '--vertices', '40']);
         const cli = tighten(dir, knot.path, 'torus23', ['--steps', '150']);
+        // the vertices of resolution 10, the final level of the long job's
+        // coarse to fine schedule
+        const finest = tighten(dir, join(CATALOGUE, '3.1.vect'), 'finest', ['--resolution', '10', '--no-coarse', '--steps', '1']);
 
         const d1 = await startDaemon({ workers: 1, dir });
         t.after(() => d1.proc.kill('SIGKILL')); // when the test fails before the kill
@@ -92,6 +99,9 @@ describe('kill -9 and restart on the same store', () => {
             assert.ok(done.started < done.finished);
             await assertResumedHistory(d2, done, stored.progress.step);
             await assertResumedFrames(d2, done);
+            // the schedule went on where it was: the job ends on its final
+            // polygon, the frames before it on coarser ones
+            assert.equal(done.vertices, (await finest).summary.vertices, 'the final level');
 
             // the two that never started run from their input, as the CLI does
             const want = (await cli).summary;
@@ -114,9 +124,10 @@ describe('SIGTERM with a running job, and restart', () => {
         const STEPS = 1600;
         const d1 = await startDaemon({ workers: 1, dir });
         t.after(() => d1.proc.kill('SIGKILL')); // when the test fails before the stop
-        const a = await submit(d1, { catalogue: '3.1', options: { resolution: 10, steps: STEPS } });
+        const a = await submit(d1, { catalogue: '3.1', options: { resolution: 10, steps: STEPS, coarse: false } });
         // stop it well into the run, where struts are active (3.1 at
-        // resolution 10 takes about 1 s for its first 1100 steps, 2 s for 1600)
+        // resolution 10 on the fine polygon alone takes about 1 s for its
+        // first 1100 steps, 2 s for 1600)
         await waitJob(d1, a.id, (j) => j.state === 'running' && j.progress.step >= 1000, { every: 10 });
         const seconds = await d1.stop();
         t.diagnostic(`SIGTERM to exit: ${seconds.toFixed(2)} s`);

@@ -133,10 +133,20 @@ async function assertFrames(job, curve) {
     all.forEach((f, i) => {
         assert.equal(f.index, i);
         assert.equal(f.step, i * every, `frame ${i} step`);
-        assert.equal(f.coordinates.length, 3 * job.vertices);
+        // a frame has the vertices of its step (fewer on a coarse level)
+        assert.equal(f.components.length, curve.counts.length);
+        assert.equal(f.coordinates.length, 3 * verticesOf(f));
+        assert.ok(verticesOf(f) <= job.vertices);
     });
-    if (expected > 0 && job.progress.step % every === 0)
+    if (expected > 0 && job.progress.step % every === 0) {
         assert.deepEqual(all.at(-1).coordinates, curve.xyz, 'the last frame is the final curve');
+        assert.deepEqual(all.at(-1).components.map((c) => (c.closed ? -c.vertices : c.vertices)), curve.counts);
+    }
+    return all;
+}
+
+function verticesOf(frame) {
+    return frame.components.reduce((sum, c) => sum + c.vertices, 0);
 }
 
 describe('a generated trefoil, T(2,3) with 40 vertices, 150 steps', () => {
@@ -180,9 +190,9 @@ describe('a generated trefoil, T(2,3) with 40 vertices, 150 steps', () => {
 describe('catalogue knot 3.1, resolution 5, 300 steps', () => {
     let cli;
     before(async () => {
-        // a job keeps one vertex count throughout: the CLI without its coarse start
+        // a job runs the command line's schedule: coarse to fine here
         cli = await tighten(dir, join(CATALOGUE, '3.1.vect'), 'cat31', [
-            '--resolution', '5', '--steps', '300', '--no-coarse',
+            '--resolution', '5', '--steps', '300',
         ]);
     });
 
@@ -212,7 +222,10 @@ describe('catalogue knot 3.1, resolution 5, 300 steps', () => {
         const curve = await assertSameCurve(job, cli);
         const h = await assertHistory(job);
         assert.ok(h.steps.at(-1).length < h.steps[0].length, 'the flow shortens the knot');
-        await assertFrames(job, curve);
+        const frames = await assertFrames(job, curve);
+        // the coarse level's frames have fewer vertices than the final
+        // curve, and say so
+        assert.ok(frames.some((f) => verticesOf(f) < job.vertices), 'frames of the coarse level');
 
         // the list shows it with the same figures
         const list = await d.get('/v1/jobs?state=done&limit=500');
