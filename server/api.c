@@ -610,9 +610,11 @@ static mhd_result get_job_frames(tk_api *a, struct MHD_Connection *c, const tk_j
         json_decref(counts);
         json_t *f = json_pack("{s:I, s:I, s:o}", "index", (json_int_t)((size_t)offset + i),
                               "step", (json_int_t)stored[i].step, "coordinates", coords);
-        json_object_set_new(f, "components", json_array_size(layout) ? layout : json_copy(comps));
-        if (!json_array_size(layout))
+        if (!json_array_size(layout)) { /* a frame stored before frames had their own */
             json_decref(layout);
+            layout = json_copy(comps);
+        }
+        json_object_set_new(f, "components", layout);
         json_array_append_new(frames, f);
     }
     tk_curve_free(&curve);
