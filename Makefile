@@ -146,8 +146,8 @@ $(BUILD)/tests/%: $(BUILD)/tests/%.o $(TEST_SUPPORT_OBJ) $(SERVER_LIB) $(COMMON_
 	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(SERVER_LIB) $(COMMON_LIB) $(LIB) $(CHECK_LIBS) \
 		$(SERVER_LIBS) $(LDLIBS)
 
-# The fuzz targets see the service's own headers too (server/submission.h).
-$(BUILD)/tests/fuzz/%.o: CPPFLAGS += -Iserver
+# The service's headers live with it; its tests and fuzz targets see them.
+$(BUILD)/server/%.o $(BUILD)/tests/%.o: CPPFLAGS += -Iserver
 
 $(BUILD)/fuzz/replay_%: $(BUILD)/tests/fuzz/fuzz_%.o $(BUILD)/tests/fuzz/replay.o $(SERVER_LIB) $(COMMON_LIB) $(LIB)
 	@mkdir -p $(dir $@)
@@ -219,7 +219,7 @@ lint:
 # Each public header compiles on its own.
 headers:
 	$(Q)for h in include/tk/*.h common/*.h; do \
-		echo "#include \"$${h#include/}\"" | $(CC) $(CPPFLAGS) -std=c11 -Wall -Wextra -Werror \
+		echo "#include \"$${h#include/}\"" | $(CC) $(CPPFLAGS) -Iserver -std=c11 -Wall -Wextra -Werror \
 			-fsyntax-only -x c - || exit 1; done
 
 clean:

@@ -1,1025 +1,948 @@
-/* tightknot: the HTTP API (see include/tk/api.h and openapi.yaml). */
-#include "tk/api.h"
+/* tightknot service: the HTTP routes (see api.h and openapi.yaml). */
+#define _GNU_SOURCE
+#include "api.h"
 
 #include <arpa/inet.h>
-#include <ctype.h>
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
-#include <math.h>
-#include <netinet/in.h>
 #include <stdarg.h>
 #include <stdatomic.h>
-#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
-#include <jansson.h>
 #include <microhttpd.h>
 
-#include "tk/jobspec.h"
 #include "jsonmap.h"
 #include "tk/vect.h"
 
-#include "submission.h"
+typedef enum MHD_Result result;
+typedef struct MHD_Connection conn;
 
-#define PAGE_LIMIT_DEFAULT 50
-#define PAGE_LIMIT_MAX 500
-#define FRAMES_LIMIT_DEFAULT 20
-#define FRAMES_LIMIT_MAX 200
-#define HISTORY_LIMIT_MAX 2000
-/* A page of frames holds at most this many coordinates (about 25 MB of
- * JSON), however many vertices the job has. */
-#define FRAMES_COORDINATES_MAX 1000000
-
-enum { CLASS_2XX, CLASS_3XX, CLASS_4XX, CLASS_5XX, CLASSES };
+typedef struct entry {
+    char *name; /* the file's name without .vect */
+    size_t components, vertices;
+} entry;
 
 struct tk_api {
     tk_api_config cfg;
     char *web;
+    entry *entries; /* the catalogue, sorted by name */
+    size_t nentries;
     struct MHD_Daemon *daemon;
-    tk_jobs *jobs;
+    tk_pool *pool;
     tk_store *store;
     atomic_bool refusing;
-    atomic_size_t buffered; /* bytes of request bodies held, all connections */
-    atomic_ullong requests[CLASSES];
-    double started;
+    atomic_size_t held;           /* bytes of request bodies held, all connections */
+    atomic_ullong responses[4];   /* by class: 2xx .. 5xx */
+    time_t started;
 };
 
-/* Per-request state: the body as it arrives. */
+/* A request's body as it arrives; cap bytes are counted in tk_api.held. */
 typedef struct request {
     char *body;
-    size_t len, cap;     /* cap bytes are counted in tk_api.buffered */
-    bool too_large;
-    bool crowded;        /* the bodies held at once reached max_body_total */
+    size_t len, cap;
+    bool too_large, crowded;
 } request;
 
-/* Gives back what a request's body held. */
-static void drop_body(tk_api *a, request *rq)
+/* ---- answers ---- */
+
+/* Sends len bytes (taken) with a type and headers (name, value, ..., NULL). */
+static result send_buffer(tk_api *a, conn *c, unsigned status, const char *type, char *buf,
+                          size_t len, const char *const *headers)
 {
-    atomic_fetch_sub(&a->buffered, rq->cap);
-    free(rq->body);
-    rq->body = NULL;
-    rq->len = rq->cap = 0;
-}
-
-typedef enum MHD_Result mhd_result;
-
-static double now_unix(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* ---- responses ---- */
-
-static mhd_result send_buffer(tk_api *a, struct MHD_Connection *c, unsigned status,
-                              const char *type, char *data, size_t len,
-                              const char *const *headers)
-{
-    struct MHD_Response *r =
-        MHD_create_response_from_buffer(len, data, MHD_RESPMEM_MUST_FREE);
+    struct MHD_Response *r = MHD_create_response_from_buffer(len, buf, MHD_RESPMEM_MUST_FREE);
     if (!r) {
-        free(data);
+        free(buf);
         return MHD_NO;
     }
-    MHD_add_response_header(r, MHD_HTTP_HEADER_CONTENT_TYPE, type);
-    MHD_add_response_header(r, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+    if (type)
+        MHD_add_response_header(r, MHD_HTTP_HEADER_CONTENT_TYPE, type);
     for (size_t i = 0; headers && headers[i]; i += 2)
         MHD_add_response_header(r, headers[i], headers[i + 1]);
-    mhd_result ret = MHD_queue_response(c, status, r);
+    result ret = MHD_queue_response(c, status, r);
     MHD_destroy_response(r);
-    int cls = status >= 500 ? CLASS_5XX : status >= 400 ? CLASS_4XX : status >= 300 ? CLASS_3XX
-                                                                                     : CLASS_2XX;
-    atomic_fetch_add(&a->requests[cls], 1);
+    if (status >= 200 && status < 600)
+        atomic_fetch_add(&a->responses[status / 100 - 2], 1);
     return ret;
 }
 
-static mhd_result send_json_headers(tk_api *a, struct MHD_Connection *c, unsigned status,
-                                    json_t *value, const char *type,
-                                    const char *const *headers)
+static result send_json(tk_api *a, conn *c, unsigned status, json_t *o, const char *type,
+                        const char *const *headers)
 {
-    char *text = tk_json_dump(value, false);
-    json_decref(value);
-    if (!text) {
-        const char *oom = "{\"type\":\"about:blank\",\"title\":\"Internal Server Error\","
-                          "\"status\":500,\"detail\":\"out of memory\"}";
-        char *copy = strdup(oom);
-        return copy ? send_buffer(a, c, 500, "application/problem+json", copy, strlen(copy), NULL)
-                    : MHD_NO;
-    }
-    return send_buffer(a, c, status, type, text, strlen(text), headers);
+    char *text = o ? tk_json_dump(o, true) : NULL;
+    json_decref(o);
+    if (!text)
+        return send_buffer(a, c, 500, "text/plain", strdup("out of memory"), 13, NULL);
+    return send_buffer(a, c, status, type ? type : "application/json", text, strlen(text), headers);
 }
 
-static mhd_result send_json(tk_api *a, struct MHD_Connection *c, unsigned status,
-                            json_t *value)
+/* An RFC 9457 problem; `extra` (taken, or NULL) adds members such as
+ * "line" or "option". */
+__attribute__((format(printf, 6, 7))) static result
+problem(tk_api *a, conn *c, unsigned status, json_t *extra, const char *const *headers,
+        const char *fmt, ...)
 {
-    return send_json_headers(a, c, status, value, "application/json", NULL);
-}
-
-static const char *status_title(unsigned status)
-{
-    switch (status) {
-    case 400: return "Bad Request";
-    case 404: return "Not Found";
-    case 405: return "Method Not Allowed";
-    case 406: return "Not Acceptable";
-    case 409: return "Conflict";
-    case 413: return "Content Too Large";
-    case 415: return "Unsupported Media Type";
-    case 422: return "Unprocessable Content";
-    case 429: return "Too Many Requests";
-    case 503: return "Service Unavailable";
-    default: return status >= 500 ? "Internal Server Error" : "Bad Request";
-    }
-}
-
-/* An RFC 9457 problem; `extra` (taken) adds members such as "line" or
- * "option", `headers` extra response headers. */
-static mhd_result send_problem_ext(tk_api *a, struct MHD_Connection *c, unsigned status,
-                                   json_t *extra, const char *const *headers, const char *fmt,
-                                   ...)
-{
-    char detail[512];
+    static const char *const titles[][2] = {
+        {"400", "Bad Request"}, {"404", "Not Found"}, {"405", "Method Not Allowed"},
+        {"413", "Content Too Large"}, {"415", "Unsupported Media Type"},
+        {"422", "Unprocessable Content"}, {"429", "Too Many Requests"},
+        {"500", "Internal Server Error"}, {"503", "Service Unavailable"}};
+    char code[8], detail[1024];
+    snprintf(code, sizeof code, "%u", status);
+    const char *title = "Error";
+    for (size_t i = 0; i < sizeof titles / sizeof titles[0]; i++)
+        title = strcmp(titles[i][0], code) ? title : titles[i][1];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(detail, sizeof detail, fmt, ap);
     va_end(ap);
-    json_t *p = json_pack("{s:s, s:s, s:i, s:o}", "type", "about:blank", "title",
-                          status_title(status), "status", (int)status, "detail",
-                          tk_json_text(detail));
-    if (p && extra)
-        json_object_update(p, extra);
+    json_t *o = json_pack("{s:s, s:s, s:i, s:o}", "type", "about:blank", "title", title, "status",
+                          (int)status, "detail", tk_json_text(detail));
+    json_object_update(o, extra);
     json_decref(extra);
-    return send_json_headers(a, c, status, p, "application/problem+json", headers);
+    return send_json(a, c, status, o, "application/problem+json", headers);
 }
+#define PROBLEM(a, c, status, ...) problem(a, c, status, NULL, NULL, __VA_ARGS__)
 
-#define send_problem(a, c, status, ...) send_problem_ext(a, c, status, NULL, NULL, __VA_ARGS__)
-
-/* A 422 for an engine or parser error: a VECT error names its line, be it
- * malformed (TK_EPARSE) or over a limit (TK_ELIMIT: too many components or
- * vertices, a count too large), as the reader's messages start "line N:". */
-static mhd_result send_input_error(tk_api *a, struct MHD_Connection *c, const tk_error *err,
-                                   const char *option)
+/* A problem for an error of the engine or the reader: a VECT error names
+ * its line ("line 3: ..."). */
+static result input_problem(tk_api *a, conn *c, const tk_error *err)
 {
-    json_t *extra = json_object();
     int line = 0;
-    if ((err->code == TK_EPARSE || err->code == TK_ELIMIT) &&
-        sscanf(err->message, "line %d", &line) == 1 && line > 0)
-        json_object_set_new(extra, "line", json_integer(line));
-    if (option)
-        json_object_set_new(extra, "option", json_string(option));
-    else if (err->code == TK_EINVAL && strncmp(err->message, "option '", 8) == 0) {
-        char name[32];
-        if (sscanf(err->message, "option '%31[a-z]'", name) == 1)
-            json_object_set_new(extra, "option", json_string(name));
-    }
-    return send_problem_ext(a, c, 422, extra, NULL, "%s", err->message);
+    json_t *extra = sscanf(err->message, "line %d", &line) == 1 ? json_pack("{s:i}", "line", line)
+                                                                  : NULL;
+    return problem(a, c, 422, extra, NULL, "%s", err->message);
 }
 
-/* ---- JSON of a job ---- */
-
-static json_t *json_time(double t)
-{
-    if (!(t > 0.0))
-        return json_null();
-    time_t secs = (time_t)t;
-    struct tm tm;
-    gmtime_r(&secs, &tm);
-    char buf[96];
-    int ms = (int)((t - (double)secs) * 1000.0);
-    if (ms < 0 || ms > 999)
-        ms = 999;
-    snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
-             tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, ms);
-    return json_string(buf);
-}
-
-static json_t *maybe_number(bool known, double x)
-{
-    return known ? tk_json_number(x) : json_null();
-}
-
-/* The job's document; `invariants` (taken) is its stored type. */
-static json_t *job_json(const tk_job *j, json_t *invariants)
-{
-    const tk_step_report *r = &j->latest;
-    bool f = j->has_figures;
-    char base[64];
-    snprintf(base, sizeof base, "/v1/jobs/%lld", (long long)j->id);
-    json_t *links = json_object();
-    const char *parts[] = {"struts", "vect", "history", "frames"};
-    json_object_set_new(links, "self", json_string(base));
-    for (size_t i = 0; i < 4; i++) {
-        char url[96];
-        snprintf(url, sizeof url, "%s/%s", base, parts[i]);
-        json_object_set_new(links, parts[i], json_string(url));
-    }
-    json_t *o = json_object();
-    json_object_set_new(o, "id", json_integer((json_int_t)j->id));
-    json_object_set_new(o, "name", tk_json_text(j->name));
-    json_object_set_new(o, "state", json_string(tk_job_state_name(j->state)));
-    json_object_set_new(o, "options", tk_job_options_to_json(&j->options));
-    json_object_set_new(o, "progress",
-                        json_pack("{s:I, s:o}", "step", (json_int_t)r->step, "fraction",
-                                  j->fraction >= 0.0 ? json_real(j->fraction) : json_null()));
-    json_object_set_new(o, "ropelength", maybe_number(f, r->ropelength));
-    json_object_set_new(o, "length", maybe_number(f, r->length));
-    json_object_set_new(o, "thickness", maybe_number(f, r->thickness));
-    json_object_set_new(o, "minrad", maybe_number(f, r->minrad));
-    json_object_set_new(o, "residual", maybe_number(f && r->step > 0, r->residual));
-    json_object_set_new(o, "struts", json_integer((json_int_t)r->struts));
-    json_object_set_new(o, "kinks", json_integer((json_int_t)r->kinks));
-    json_object_set_new(o, "vertices", json_integer((json_int_t)r->vertices));
-    json_object_set_new(o, "components", json_integer((json_int_t)j->components));
-    json_object_set_new(o, "seconds", tk_json_number(r->seconds));
-    json_object_set_new(o, "step_size", maybe_number(f && r->step > 0, r->step_size));
-    json_object_set_new(o, "frames", json_integer((json_int_t)j->frames));
-    json_object_set_new(o, "stop_reason",
-                        j->stop_reason[0] ? json_string(j->stop_reason) : json_null());
-    json_object_set_new(o, "error", j->error[0] ? tk_json_text(j->error) : json_null());
-    json_object_set_new(o, "invariants", invariants ? invariants : json_null());
-    json_object_set_new(o, "created", json_time(j->created));
-    json_object_set_new(o, "started", json_time(j->started));
-    json_object_set_new(o, "finished", json_time(j->finished));
-    json_object_set_new(o, "links", links);
-    return o;
-}
-
-/* A stored text that does not read back as written: a 500 naming it, and
- * the store reported damaged (health says so). */
-static mhd_result damaged(tk_api *a, struct MHD_Connection *c, const tk_job *job,
-                          const char *what, const char *why)
+/* A stored text that does not read back as written: 500, and health says
+ * the store is damaged. */
+static result damaged(tk_api *a, conn *c, int64_t id, const char *what, const char *why)
 {
     char message[TK_ERROR_MESSAGE_SIZE];
     snprintf(message, sizeof message, "the stored %s of job %lld does not read back: %.200s",
-             what, (long long)job->id, why);
-    tk_store_report_damage(a->store, message);
-    return send_problem(a, c, 500, "%s", message);
+             what, (long long)id, why);
+    tk_store_damage(a->store, message);
+    return PROBLEM(a, c, 500, "%s", message);
 }
 
-/* The job's document with its type as the store holds it (written with
- * the figures every few seconds while the job runs, null before it
- * starts, and null when the job was deleted since it was read); false,
- * with a 500 sent, when the store fails or the stored type does not read
- * back. */
-static bool job_document(tk_api *a, struct MHD_Connection *c, const tk_job *job, json_t **doc,
-                         mhd_result *ret)
+static result store_problem(tk_api *a, conn *c, int rc, const tk_error *err)
 {
-    char *text = NULL;
-    size_t len = 0;
-    tk_error err;
-    int rc = tk_store_text(a->store, job->id, TK_TEXT_INVARIANTS, &text, &len, &err);
-    if (rc && rc != TK_ENOTFOUND) {
-        *ret = send_problem(a, c, 500, "%s", err.message);
-        return false;
-    }
-    json_error_t jerr;
-    json_t *type = text ? json_loadb(text, len, 0, &jerr) : json_null();
-    free(text);
-    if (!type) {
-        *ret = damaged(a, c, job, "knot type", jerr.text);
-        return false;
-    }
-    *doc = job_json(job, type);
-    return true;
+    if (rc == TK_EIO && strstr(err->message, "does not read back"))
+        tk_store_damage(a->store, err->message);
+    return PROBLEM(a, c, rc == TK_ENOTFOUND ? 404 : 500, "%s", err->message);
 }
 
-static mhd_result send_job(tk_api *a, struct MHD_Connection *c, unsigned status,
-                           const tk_job *job, const char *const *headers)
-{
-    json_t *doc = NULL;
-    mhd_result ret = MHD_NO;
-    if (!job_document(a, c, job, &doc, &ret))
-        return ret;
-    return send_json_headers(a, c, status, doc, "application/json", headers);
-}
-
-/* ---- query parameters ---- */
-
-/* Reads a whole-number query parameter within [lo, hi]; false (and a 400
- * already sent) when malformed. */
-static bool query_count(tk_api *a, struct MHD_Connection *c, const char *name, long dflt,
-                        long lo, long hi, long *out, mhd_result *ret)
+/* Reads a whole-number query parameter in [lo, hi] (dflt when absent);
+ * false when it is malformed (then *ret is the 400 sent). */
+static bool query_count(tk_api *a, conn *c, const char *name, long dflt, long lo, long hi,
+                        long *out, result *ret)
 {
     const char *v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, name);
-    *out = dflt;
-    if (!v)
-        return true;
     char *end = NULL;
     errno = 0;
-    long n = strtol(v, &end, 10);
-    if (errno || end == v || *end || n < lo || n > hi) {
-        json_t *extra = json_pack("{s:s}", "parameter", name);
-        *ret = send_problem_ext(a, c, 400, extra, NULL,
-                                "query parameter '%s' must be a whole number from %ld to %ld",
-                                name, lo, hi);
-        return false;
-    }
-    *out = n;
-    return true;
-}
-
-/* ---- handlers ---- */
-
-static mhd_result get_health(tk_api *a, struct MHD_Connection *c)
-{
-    tk_jobs_stats s;
-    tk_jobs_stats_get(a->jobs, &s);
-    char reason[TK_ERROR_MESSAGE_SIZE + 64];
-    /* A store that cannot take jobs makes the service unusable: a 503
-     * problem saying why, for a load balancer or a watchdog to see. */
-    if (!tk_store_health(a->store, reason, sizeof reason))
-        return send_problem_ext(a, c, 503, json_pack("{s:s}", "health", "degraded"), NULL, "%s",
-                                reason);
-    json_t *o = json_pack("{s:s, s:I, s:I, s:I, s:I, s:f}", "status", "ok", "workers",
-                          (json_int_t)s.workers, "running", (json_int_t)s.running, "queued",
-                          (json_int_t)s.queued, "queue_limit", (json_int_t)s.queue_limit,
-                          "uptime", now_unix() - a->started);
-    return send_json(a, c, 200, o);
-}
-
-static mhd_result get_metrics(tk_api *a, struct MHD_Connection *c)
-{
-    tk_jobs_stats s;
-    tk_jobs_stats_get(a->jobs, &s);
-    size_t counts[TK_JOB_STATES];
-    tk_error err;
-    if (tk_store_count_states(a->store, counts, &err) != TK_OK)
-        return send_problem(a, c, 500, "%s", err.message);
-    char *buf = NULL;
-    size_t len = 0;
-    FILE *f = open_memstream(&buf, &len);
-    if (!f)
-        return send_problem(a, c, 500, "out of memory");
-    fputs("# HELP tightknot_jobs Jobs in the store by state.\n# TYPE tightknot_jobs gauge\n", f);
-    for (int i = 0; i < TK_JOB_STATES; i++)
-        fprintf(f, "tightknot_jobs{state=\"%s\"} %zu\n", tk_job_state_name((tk_job_state)i),
-                counts[i]);
-    fprintf(f, "# HELP tightknot_queue_length Jobs waiting for a worker.\n"
-               "# TYPE tightknot_queue_length gauge\ntightknot_queue_length %zu\n",
-            s.queued);
-    fprintf(f, "# HELP tightknot_queue_limit Queued jobs beyond which submissions get 429.\n"
-               "# TYPE tightknot_queue_limit gauge\ntightknot_queue_limit %zu\n",
-            s.queue_limit);
-    fprintf(f, "# HELP tightknot_workers Worker threads.\n# TYPE tightknot_workers gauge\n"
-               "tightknot_workers %zu\n",
-            s.workers);
-    fprintf(f, "# HELP tightknot_workers_busy Workers running a job.\n"
-               "# TYPE tightknot_workers_busy gauge\ntightknot_workers_busy %zu\n",
-            s.running);
-    fprintf(f, "# HELP tightknot_steps_total Flow steps taken since start.\n"
-               "# TYPE tightknot_steps_total counter\ntightknot_steps_total %llu\n",
-            s.steps_total);
-    fprintf(f, "# HELP tightknot_steps_per_second Steps per second over the running jobs.\n"
-               "# TYPE tightknot_steps_per_second gauge\ntightknot_steps_per_second %.6g\n",
-            s.steps_per_second);
-    fprintf(f, "# HELP tightknot_http_body_bytes_held Bytes of request bodies held now, all "
-               "connections (at most --max-body-total).\n"
-               "# TYPE tightknot_http_body_bytes_held gauge\ntightknot_http_body_bytes_held %zu\n",
-            atomic_load(&a->buffered));
-    fputs("# HELP tightknot_http_responses_total HTTP responses by status class.\n"
-          "# TYPE tightknot_http_responses_total counter\n",
-          f);
-    const char *cls[CLASSES] = {"2xx", "3xx", "4xx", "5xx"};
-    for (int i = 0; i < CLASSES; i++)
-        fprintf(f, "tightknot_http_responses_total{code=\"%s\"} %llu\n", cls[i],
-                atomic_load(&a->requests[i]));
-    if (fclose(f) != 0) {
-        free(buf);
-        return send_problem(a, c, 500, "out of memory");
-    }
-    return send_buffer(a, c, 200, "text/plain; version=0.0.4; charset=utf-8", buf, len, NULL);
-}
-
-static mhd_result get_catalogue(tk_api *a, struct MHD_Connection *c)
-{
-    if (!a->cfg.catalogue)
-        return send_problem(a, c, 404, "this server has no catalogue (start it with --catalogue)");
-    size_t n = 0;
-    const tk_catalogue_entry *e = tk_catalogue_entries(a->cfg.catalogue, &n);
-    json_t *list = json_array();
-    for (size_t i = 0; i < n; i++)
-        json_array_append_new(list, json_pack("{s:o, s:I, s:I}", "name", tk_json_text(e[i].name),
-                                              "components", (json_int_t)e[i].components,
-                                              "vertices", (json_int_t)e[i].vertices));
-    return send_json(a, c, 200, json_pack("{s:I, s:o}", "count", (json_int_t)n, "knots", list));
-}
-
-static mhd_result get_catalogue_entry(tk_api *a, struct MHD_Connection *c, const char *name)
-{
-    if (!a->cfg.catalogue)
-        return send_problem(a, c, 404, "this server has no catalogue (start it with --catalogue)");
-    const tk_catalogue_entry *e = tk_catalogue_find(a->cfg.catalogue, name);
-    char *text = NULL;
-    size_t len = 0;
-    tk_error err;
-    if (!e)
-        return send_problem(a, c, 404, "the catalogue has no knot '%.80s'", name);
-    if (tk_catalogue_read(a->cfg.catalogue, name, &text, &len, &err) != TK_OK)
-        return send_problem(a, c, 500, "%s", err.message);
-    json_t *o = json_pack("{s:o, s:I, s:I, s:s%}", "name", tk_json_text(e->name), "components",
-                          (json_int_t)e->components, "vertices", (json_int_t)e->vertices, "vect",
-                          text, len);
-    free(text);
-    if (!o)
-        return send_problem(a, c, 500, "the catalogue file '%.80s' is not UTF-8 text", name);
-    return send_json(a, c, 200, o);
-}
-
-static mhd_result list_jobs(tk_api *a, struct MHD_Connection *c)
-{
-    mhd_result ret = MHD_NO;
-    long offset, limit;
-    if (!query_count(a, c, "offset", 0, 0, LONG_MAX, &offset, &ret) ||
-        !query_count(a, c, "limit", PAGE_LIMIT_DEFAULT, 1, PAGE_LIMIT_MAX, &limit, &ret))
-        return ret;
-    const char *state_name = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "state");
-    tk_job_state state = TK_JOB_QUEUED;
-    if (state_name && !tk_job_state_parse(state_name, &state))
-        return send_problem_ext(a, c, 400, json_pack("{s:s}", "parameter", "state"), NULL,
-                                "query parameter 'state' must be one of queued, running, done, "
-                                "failed, cancelled");
-    tk_job *jobs = NULL;
-    size_t n = 0, total = 0;
-    tk_error err;
-    if (tk_store_list(a->store, state_name != NULL, state, (size_t)offset, (size_t)limit, &jobs,
-                      &n, &total, &err) != TK_OK)
-        return send_problem(a, c, 500, "%s", err.message);
-    json_t *list = json_array();
-    for (size_t i = 0; i < n; i++) {
-        /* running jobs show their live figures */
-        tk_job live;
-        if (jobs[i].state == TK_JOB_RUNNING && tk_jobs_get(a->jobs, jobs[i].id, &live, NULL) == 0)
-            jobs[i] = live;
-        json_t *doc = NULL;
-        if (!job_document(a, c, &jobs[i], &doc, &ret)) {
-            json_decref(list);
-            free(jobs);
-            return ret;
-        }
-        json_array_append_new(list, doc);
-    }
-    free(jobs);
-    return send_json(a, c, 200,
-                     json_pack("{s:o, s:I, s:I, s:I}", "jobs", list, "total", (json_int_t)total,
-                               "offset", (json_int_t)offset, "limit", (json_int_t)limit));
-}
-
-/* Looks a job up; false (with a 404 sent) when there is none. */
-static bool find_job(tk_api *a, struct MHD_Connection *c, int64_t id, tk_job *job,
-                     mhd_result *ret)
-{
-    tk_error err;
-    int rc = tk_jobs_get(a->jobs, id, job, &err);
-    if (rc == TK_OK)
+    *out = v ? strtol(v, &end, 10) : dflt;
+    if (!v || (!errno && end != v && !*end && *out >= lo && *out <= hi))
         return true;
-    *ret = send_problem(a, c, rc == TK_ENOTFOUND ? 404 : 500, "%s", err.message);
+    *ret = problem(a, c, 400, json_pack("{s:s}", "parameter", name), NULL,
+                   "query parameter '%s' must be a whole number from %ld to %ld", name, lo, hi);
     return false;
 }
 
-static bool accepts_json(struct MHD_Connection *c)
+/* ---- jobs ---- */
+
+/* The job's document as served: with its links. */
+static json_t *with_links(json_t *doc)
 {
-    const char *accept = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_ACCEPT);
-    return accept && strstr(accept, "application/json") && !strstr(accept, "text/plain");
+    char self[64];
+    snprintf(self, sizeof self, "/v1/jobs/%lld", (long long)tk_job_id(doc));
+    json_t *links = json_pack("{s:s}", "self", self);
+    const char *parts[] = {"struts", "vect", "history", "frames"};
+    for (size_t i = 0; i < 4; i++)
+        json_object_set_new(links, parts[i], json_sprintf("%s/%s", self, parts[i]));
+    json_object_set_new(doc, "links", links);
+    return doc;
 }
 
-static mhd_result get_job_vect(tk_api *a, struct MHD_Connection *c, const tk_job *job)
+/* The job as it stands: live from its worker while it runs here. */
+static int get_job(tk_api *a, int64_t id, json_t **doc, tk_error *err)
+{
+    *doc = tk_pool_live(a->pool, id);
+    return *doc ? TK_OK : tk_store_get(a->store, id, doc, err);
+}
+
+static result list_jobs(tk_api *a, conn *c)
+{
+    result ret = MHD_NO;
+    long offset, limit;
+    if (!query_count(a, c, "offset", 0, 0, LONG_MAX, &offset, &ret) ||
+        !query_count(a, c, "limit", 50, 1, 500, &limit, &ret))
+        return ret;
+    const char *name = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "state");
+    int state = name ? tk_job_state_of(name) : -1;
+    if (name && state < 0)
+        return problem(a, c, 400, json_pack("{s:s}", "parameter", "state"), NULL,
+                       "query parameter 'state' must be one of queued, running, done, failed, "
+                       "cancelled");
+    json_t *docs = NULL, *doc;
+    size_t total = 0, i;
+    tk_error err;
+    int rc = tk_store_list(a->store, state, (size_t)offset, (size_t)limit, &docs, &total, &err);
+    if (rc) {
+        json_decref(docs);
+        return store_problem(a, c, rc, &err);
+    }
+    json_array_foreach(docs, i, doc) {
+        json_t *live = tk_job_state_in(doc) == TK_JOB_RUNNING ? tk_pool_live(a->pool, tk_job_id(doc))
+                                                               : NULL;
+        json_array_set_new(docs, i, with_links(live ? live : json_incref(doc)));
+    }
+    return send_json(a, c, 200, json_pack("{s:o, s:I, s:I, s:I}", "jobs", docs, "total",
+                                          (json_int_t)total, "offset", (json_int_t)offset,
+                                          "limit", (json_int_t)limit), NULL, NULL);
+}
+
+
+/* The catalogue entry called name, or NULL. */
+static const entry *find_entry(const tk_api *a, const char *name)
+{
+    for (size_t i = 0; i < a->nentries; i++)
+        if (!strcmp(a->entries[i].name, name))
+            return &a->entries[i];
+    return NULL;
+}
+
+/* A file's whole text (NUL-terminated), or NULL. */
+static char *read_file(const char *dir, const char *name, const char *suffix, size_t *len)
+{
+    char *path = NULL, *text = NULL;
+    FILE *f = asprintf(&path, "%s/%s%s", dir, name, suffix) < 0 ? NULL : fopen(path, "rb");
+    free(path);
+    if (f) {
+        FILE *out = open_memstream(&text, len);
+        char buf[65536];
+        size_t n;
+        while (out && (n = fread(buf, 1, sizeof buf, f)) > 0)
+            fwrite(buf, 1, n, out);
+        if (out)
+            fclose(out);
+        fclose(f);
+    }
+    return text;
+}
+
+typedef struct query_list {
+    tk_query_pair pairs[64];
+    size_t n;
+} query_list;
+
+static result collect(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+{
+    (void)kind;
+    query_list *q = cls;
+    if (q->n < 64)
+        q->pairs[q->n] = (tk_query_pair){key, value};
+    q->n++;
+    return MHD_YES;
+}
+
+static result post_job(tk_api *a, conn *c, const request *rq)
+{
+    query_list q = {.n = 0};
+    MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, collect, &q);
+    if (q.n > 64)
+        return PROBLEM(a, c, 400, "more than 64 query parameters");
+    tk_submission sub;
+    tk_problem p;
+    if (tk_submission_decode(MHD_lookup_connection_value(c, MHD_HEADER_KIND,
+                                                         MHD_HTTP_HEADER_CONTENT_TYPE),
+                             q.pairs, q.n, rq->body, rq->len, &sub, &p))
+        return problem(a, c, p.status, p.member[0] ? json_pack("{s:s}", p.member, p.value) : NULL,
+                       NULL, "%s", p.detail);
+    char *text = NULL;
+    if (sub.catalogue && a->entries && find_entry(a, sub.catalogue))
+        sub.vect = text = read_file(a->cfg.catalogue, sub.catalogue, ".vect", &sub.len);
+    if (sub.catalogue && !sub.vect) {
+        tk_submission_clear(&sub);
+        return problem(a, c, 422, json_pack("{s:s}", "field", "catalogue"), NULL,
+                       a->entries ? "the catalogue has no knot of that name"
+                                  : "this server has no catalogue (start it with --catalogue)");
+    }
+    tk_vect_limits limits = TK_VECT_LIMITS_INIT;
+    limits.max_vertices = a->cfg.max_vertices;
+    tk_curve *curve = NULL;
+    tk_error err;
+    result ret;
+    /* what is known without the engine: the text, its limits, the
+     * magnitudes the engine measures in, the options together */
+    if (tk_vect_parse(sub.vect, sub.len, &limits, &curve, &err) ||
+        tk_curve_check_range(curve, &err)) {
+        ret = input_problem(a, c, &err);
+    } else if (tk_options_check(&sub.options.run, &err)) {
+        ret = input_problem(a, c, &err);
+    } else {
+        /* the reader refuses a NUL anywhere: the text is a C string */
+        json_t *doc = tk_job_new(sub.name, &sub.options, curve->ncomp, curve->nvert);
+        char *input = strndup(sub.vect, sub.len);
+        int rc = doc && input ? tk_pool_submit(a->pool, doc, input, &err)
+                              : tk_error_set(&err, TK_ENOMEM, "out of memory");
+        const char *retry[] = {MHD_HTTP_HEADER_RETRY_AFTER, "30", NULL};
+        if (rc == TK_EBUSY)
+            ret = problem(a, c, atomic_load(&a->refusing) ? 503 : 429, NULL, retry, "%s",
+                          err.message);
+        else if (rc)
+            ret = store_problem(a, c, rc, &err);
+        if (!rc) {
+            char location[64];
+            snprintf(location, sizeof location, "/v1/jobs/%lld", (long long)tk_job_id(doc));
+            const char *headers[] = {MHD_HTTP_HEADER_LOCATION, location, NULL};
+            ret = send_json(a, c, 202, with_links(json_incref(doc)), NULL, headers);
+        }
+        json_decref(doc);
+        free(input);
+    }
+    tk_curve_free(&curve);
+    free(text);
+    tk_submission_clear(&sub);
+    return ret;
+}
+
+static result cancel_job(tk_api *a, conn *c, int64_t id)
+{
+    json_t *doc = NULL;
+    tk_error err;
+    int rc = tk_pool_cancel(a->pool, id, &doc, &err);
+    if (rc == TK_EINVAL && (rc = tk_store_delete(a->store, id, &err)) == TK_OK)
+        return send_buffer(a, c, 204, NULL, NULL, 0, NULL); /* ended: it goes */
+    if (rc == TK_EBUSY)
+        return PROBLEM(a, c, 503, "%s", err.message);
+    if (rc)
+        return store_problem(a, c, rc, &err);
+    /* a queued job is cancelled now (200), a running one within a step (202) */
+    unsigned status = tk_job_state_in(doc) == TK_JOB_CANCELLED ? 200 : 202;
+    return send_json(a, c, status, with_links(doc), NULL, NULL);
+}
+
+/* A stored part as JSON; NULL with *ret sent when it does not read back. */
+static json_t *part_json(tk_api *a, conn *c, int64_t id, tk_part part, const char *what,
+                         result *ret, bool *missing)
 {
     char *text = NULL;
     size_t len = 0;
     tk_error err;
-    int rc = tk_store_text(a->store, job->id, TK_TEXT_CURVE, &text, &len, &err);
-    if (!rc && !text) /* not started yet: the input is the current curve */
-        rc = tk_store_text(a->store, job->id, TK_TEXT_INPUT, &text, &len, &err);
+    int rc = tk_store_part(a->store, id, part, &text, &len, &err);
+    json_error_t jerr;
+    json_t *o = text ? json_loadb(text, len, 0, &jerr) : NULL;
+    *missing = !rc && !text;
     if (rc)
-        return send_problem(a, c, 500, "%s", err.message);
-    /* Every stored curve parsed when it was written: one that does not now
-     * was damaged in the store, and is not served as if it were a knot. */
-    tk_curve *check = NULL;
-    if (text && tk_vect_parse(text, len, NULL, &check, &err) != TK_OK) {
-        free(text);
-        return damaged(a, c, job, "curve", err.message);
+        *ret = store_problem(a, c, rc, &err);
+    else if (text && !o)
+        *ret = damaged(a, c, id, what, jerr.text);
+    free(text);
+    return o;
+}
+
+static result get_struts(tk_api *a, conn *c, const json_t *doc)
+{
+    result ret = MHD_NO;
+    bool missing;
+    json_t *o = part_json(a, c, tk_job_id(doc), TK_PART_CONTACTS, "contacts", &ret, &missing);
+    if (missing) /* not measured yet */
+        o = json_pack("{s:i, s:n, s:[], s:[], s:[]}", "step", 0, "thickness", "components",
+                      "struts", "kinks");
+    if (!o)
+        return ret;
+    json_object_set_new(o, "id", json_integer(tk_job_id(doc)));
+    return send_json(a, c, 200, o, NULL, NULL);
+}
+
+static result get_history(tk_api *a, conn *c, const json_t *doc)
+{
+    result ret = MHD_NO;
+    bool missing;
+    long limit;
+    if (!query_count(a, c, "limit", 2000, 2, 2000, &limit, &ret))
+        return ret;
+    json_t *steps = part_json(a, c, tk_job_id(doc), TK_PART_HISTORY, "history", &ret, &missing);
+    if (!steps && !missing)
+        return ret;
+    steps = json_is_array(steps) ? steps : json_array();
+    size_t n = json_array_size(steps);
+    if (n > (size_t)limit) { /* at most `limit`, evenly thinned, the last kept */
+        json_t *thin = json_array();
+        for (size_t i = 0; i < (size_t)limit; i++)
+            json_array_append(thin, json_array_get(steps, (size_t)((double)i * (double)(n - 1) /
+                                                                   (double)(limit - 1) + 0.5)));
+        json_decref(steps);
+        steps = thin;
     }
-    tk_curve_free(&check);
-    if (accepts_json(c)) {
-        json_t *o = json_pack("{s:I, s:I, s:s%}", "id", (json_int_t)job->id, "step",
-                              (json_int_t)job->latest.step, "vect", text ? text : "", len);
+    return send_json(a, c, 200, json_pack("{s:I, s:I, s:o}", "id", tk_job_id(doc), "step",
+                                          (json_int_t)tk_job_step(doc), "steps", steps), NULL, NULL);
+}
+
+/* The job's curve (its input before the run starts), parsed to check it. */
+static char *job_curve(tk_api *a, conn *c, const json_t *doc, size_t *len, tk_curve **curve,
+                       result *ret)
+{
+    char *text = NULL;
+    tk_error err;
+    int rc = tk_store_part(a->store, tk_job_id(doc), TK_PART_CURVE, &text, len, &err);
+    if (!rc && !text)
+        rc = tk_store_part(a->store, tk_job_id(doc), TK_PART_INPUT, &text, len, &err);
+    if (rc)
+        *ret = store_problem(a, c, rc, &err);
+    else if (tk_vect_parse(text, *len, NULL, curve, &err))
+        *ret = damaged(a, c, tk_job_id(doc), "curve", err.message);
+    if (!*curve) {
         free(text);
-        return send_json(a, c, 200, o);
+        return NULL;
     }
-    char name[TK_JOB_NAME_SIZE + 64];
-    snprintf(name, sizeof name, "inline; filename=\"job-%lld.vect\"", (long long)job->id);
+    return text;
+}
+
+static result get_vect(tk_api *a, conn *c, const json_t *doc)
+{
+    size_t len = 0;
+    tk_curve *curve = NULL;
+    result ret = MHD_NO;
+    char *text = job_curve(a, c, doc, &len, &curve, &ret);
+    tk_curve_free(&curve);
+    if (!text)
+        return ret;
+    const char *accept = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_ACCEPT);
+    if (accept && strstr(accept, "application/json") && !strstr(accept, "text/plain")) {
+        json_t *o = json_pack("{s:I, s:I, s:s%}", "id", tk_job_id(doc), "step",
+                              (json_int_t)tk_job_step(doc), "vect", text, len);
+        free(text);
+        return send_json(a, c, 200, o, NULL, NULL);
+    }
+    char name[64];
+    snprintf(name, sizeof name, "inline; filename=\"job-%lld.vect\"", (long long)tk_job_id(doc));
     const char *headers[] = {"Content-Disposition", name, NULL};
     return send_buffer(a, c, 200, "text/plain; charset=utf-8", text, len, headers);
 }
 
-static mhd_result get_job_text_json(tk_api *a, struct MHD_Connection *c, const tk_job *job,
-                                    tk_job_text which)
+static result get_frames(tk_api *a, conn *c, const json_t *doc)
 {
-    char *text = NULL;
-    size_t len = 0;
-    tk_error err;
-    if (tk_store_text(a->store, job->id, which, &text, &len, &err) != TK_OK)
-        return send_problem(a, c, 500, "%s", err.message);
-    json_error_t jerr;
-    json_t *doc = text ? json_loadb(text, len, 0, &jerr) : NULL;
-    bool broken = text && !doc;
-    free(text);
-    if (broken)
-        return damaged(a, c, job, which == TK_TEXT_CONTACTS ? "contacts" : "history", jerr.text);
-    if (which == TK_TEXT_CONTACTS) {
-        if (!doc) /* not measured yet */
-            doc = json_pack("{s:I, s:n, s:[], s:[], s:[]}", "step", (json_int_t)0, "thickness",
-                            "components", "struts", "kinks");
-        json_object_set_new(doc, "id", json_integer((json_int_t)job->id));
-        return send_json(a, c, 200, doc);
-    }
-    /* history: at most `limit` entries, evenly thinned, the last kept */
-    mhd_result ret = MHD_NO;
-    long limit;
-    if (!query_count(a, c, "limit", HISTORY_LIMIT_MAX, 2, HISTORY_LIMIT_MAX, &limit, &ret)) {
-        json_decref(doc);
-        return ret;
-    }
-    json_t *steps = json_is_array(doc) ? doc : json_array();
-    if (steps != doc)
-        json_decref(doc);
-    size_t n = json_array_size(steps);
-    if (n > (size_t)limit) {
-        json_t *thin = json_array();
-        for (size_t i = 0; i < (size_t)limit; i++) {
-            size_t at = (size_t)((double)i * (double)(n - 1) / (double)(limit - 1) + 0.5);
-            json_array_append(thin, json_array_get(steps, at));
-        }
-        json_decref(steps);
-        steps = thin;
-    }
-    return send_json(a, c, 200,
-                     json_pack("{s:I, s:I, s:o}", "id", (json_int_t)job->id, "step",
-                               (json_int_t)job->latest.step, "steps", steps));
-}
-
-static mhd_result get_job_frames(tk_api *a, struct MHD_Connection *c, const tk_job *job)
-{
-    mhd_result ret = MHD_NO;
+    result ret = MHD_NO;
     long offset, limit;
     if (!query_count(a, c, "offset", 0, 0, LONG_MAX, &offset, &ret) ||
-        !query_count(a, c, "limit", FRAMES_LIMIT_DEFAULT, 1, FRAMES_LIMIT_MAX, &limit, &ret))
+        !query_count(a, c, "limit", 20, 1, 200, &limit, &ret))
         return ret;
-    size_t per_frame = 3 * job->latest.vertices;
-    if (per_frame > 0 && (size_t)limit * per_frame > FRAMES_COORDINATES_MAX)
-        limit = (long)(FRAMES_COORDINATES_MAX / per_frame > 0 ? FRAMES_COORDINATES_MAX / per_frame
-                                                               : 1);
-    tk_store_frame *stored = NULL;
-    size_t n = 0;
-    tk_error err;
-    if (tk_store_frames(a->store, job->id, (size_t)offset, (size_t)limit, &stored, &n, &err) !=
-        TK_OK)
-        return send_problem(a, c, 500, "%s", err.message);
-    /* the component layout, from the stored curve: a frame has its own
-     * vertex counts when the run resampled (coarse to fine,
-     * re-resolution), the curve's closed components always */
-    json_t *comps = json_array();
-    char *text = NULL;
-    size_t len = 0;
+    /* a page holds at most 10^6 coordinates, however large the knot */
+    long per = 3 * (long)json_integer_value(json_object_get(doc, "vertices"));
+    if (per > 0 && limit * per > 1000000)
+        limit = 1000000 / per > 0 ? 1000000 / per : 1;
+    size_t len = 0, n = 0;
     tk_curve *curve = NULL;
-    if (tk_store_text(a->store, job->id, TK_TEXT_CURVE, &text, &len, NULL) == TK_OK && text &&
-        tk_vect_parse(text, len, NULL, &curve, NULL) == TK_OK)
-        for (size_t k = 0; k < curve->ncomp; k++)
-            json_array_append_new(comps, json_pack("{s:I, s:b}", "vertices",
-                                                   (json_int_t)tk_curve_comp_vertices(curve, k),
-                                                   "closed", curve->closed[k]));
+    char *text = job_curve(a, c, doc, &len, &curve, &ret);
+    if (!text)
+        return ret;
     free(text);
-    json_t *frames = json_array();
+    tk_frame *stored = NULL;
+    tk_error err;
+    int64_t id = tk_job_id(doc);
+    if (tk_store_frames(a->store, id, (size_t)offset, (size_t)limit, &stored, &n, &err)) {
+        tk_frames_free(stored, n);
+        tk_curve_free(&curve);
+        return store_problem(a, c, TK_EIO, &err);
+    }
+    /* a frame's components: its own vertex counts (the run resampled), the
+     * curve's closedness */
+    json_t *comps = json_array(), *frames = json_array();
+    for (size_t k = 0; k < curve->ncomp; k++)
+        json_array_append_new(comps, json_pack("{s:I, s:b}", "vertices", (json_int_t)
+                                               tk_curve_comp_vertices(curve, k), "closed",
+                                               curve->closed[k]));
     for (size_t i = 0; i < n; i++) {
         json_t *coords = json_array();
         for (size_t k = 0; k < stored[i].count; k++)
             json_array_append_new(coords, tk_json_number(stored[i].xyz[k]));
         json_t *counts = stored[i].layout ? json_loads(stored[i].layout, 0, NULL) : NULL;
-        json_t *layout = json_array();
-        for (size_t k = 0; k < json_array_size(counts) && curve && k < curve->ncomp; k++)
-            json_array_append_new(layout,
-                                  json_pack("{s:O, s:b}", "vertices", json_array_get(counts, k),
-                                            "closed", curve->closed[k]));
+        json_t *layout = json_array_size(counts) == curve->ncomp ? json_array() : json_copy(comps);
+        for (size_t k = 0; json_array_size(counts) == curve->ncomp && k < curve->ncomp; k++)
+            json_array_append_new(layout, json_pack("{s:O, s:b}", "vertices",
+                                                    json_array_get(counts, k), "closed",
+                                                    curve->closed[k]));
         json_decref(counts);
-        json_t *f = json_pack("{s:I, s:I, s:o}", "index", (json_int_t)((size_t)offset + i),
-                              "step", (json_int_t)stored[i].step, "coordinates", coords);
-        if (!json_array_size(layout)) { /* a frame stored before frames had their own */
-            json_decref(layout);
-            layout = json_copy(comps);
-        }
-        json_object_set_new(f, "components", layout);
-        json_array_append_new(frames, f);
+        json_array_append_new(frames, json_pack("{s:I, s:I, s:o, s:o}", "index", (json_int_t)
+                                                offset + (json_int_t)i, "step",
+                                                (json_int_t)stored[i].step, "coordinates",
+                                                coords, "components", layout));
     }
     tk_curve_free(&curve);
-    tk_store_frames_free(stored, n);
+    tk_frames_free(stored, n);
     return send_json(a, c, 200,
-                     json_pack("{s:I, s:I, s:I, s:I, s:o, s:o}", "id", (json_int_t)job->id,
-                               "total", (json_int_t)job->frames, "offset", (json_int_t)offset,
-                               "limit", (json_int_t)limit, "components", comps, "frames",
-                               frames));
+                     json_pack("{s:I, s:O, s:I, s:I, s:o, s:o}", "id", id, "total",
+                               json_object_get(doc, "frames"), "offset", (json_int_t)offset,
+                               "limit", (json_int_t)limit, "components", comps, "frames", frames),
+                     NULL, NULL);
 }
 
-static mhd_result cancel_job(tk_api *a, struct MHD_Connection *c, int64_t id)
+/* ---- the service ---- */
+
+static result get_health(tk_api *a, conn *c)
 {
-    tk_job job;
+    tk_pool_stats s;
+    tk_pool_stats_get(a->pool, &s);
+    size_t counts[TK_JOB_STATES];
+    char reason[TK_ERROR_MESSAGE_SIZE + 64];
     tk_error err;
-    int rc = tk_jobs_cancel(a->jobs, id, &job, &err);
-    if (rc == TK_EINVAL) {
-        /* finished: no worker touches it again, so it can go */
-        rc = tk_store_delete(a->store, id, &err);
-        if (rc == TK_OK) {
-            struct MHD_Response *r = MHD_create_response_from_buffer(0, NULL,
-                                                                     MHD_RESPMEM_PERSISTENT);
-            if (!r)
-                return MHD_NO;
-            mhd_result ret = MHD_queue_response(c, 204, r);
-            MHD_destroy_response(r);
-            atomic_fetch_add(&a->requests[CLASS_2XX], 1);
-            return ret;
-        }
-    }
-    if (rc == TK_ENOTFOUND)
-        return send_problem(a, c, 404, "%s", err.message);
-    if (rc)
-        return send_problem(a, c, 500, "%s", err.message);
-    /* a queued job is cancelled now (200); a running one stops within a
-     * step (202) */
-    return send_job(a, c, job.state == TK_JOB_CANCELLED ? 200 : 202, &job, NULL);
+    /* a store that cannot take jobs: 503 saying why, for a watchdog */
+    if (!tk_store_health(a->store, reason, sizeof reason) ||
+        (tk_store_counts(a->store, counts, &err) &&
+         snprintf(reason, sizeof reason, "%s", err.message)))
+        return problem(a, c, 503, json_pack("{s:s}", "health", "degraded"), NULL, "%s", reason);
+    return send_json(a, c, 200, json_pack("{s:s, s:I, s:I, s:I, s:I, s:I}", "status", "ok",
+                                          "workers", (json_int_t)s.workers, "running",
+                                          (json_int_t)s.running, "queued",
+                                          (json_int_t)counts[TK_JOB_QUEUED], "queue_limit",
+                                          (json_int_t)s.queue_limit, "uptime",
+                                          (json_int_t)(time(NULL) - a->started)), NULL, NULL);
 }
 
-/* ---- submitting ---- */
-
-/* The query's parameters, in order, for tk_submission_decode. */
-typedef struct query_list {
-    tk_query_pair *pairs;
-    size_t n, cap;
-    bool failed;
-} query_list;
-
-static mhd_result collect_query(void *cls, enum MHD_ValueKind kind, const char *key,
-                                const char *value)
+static result get_metrics(tk_api *a, conn *c)
 {
-    (void)kind;
-    query_list *q = cls;
-    if (q->n == q->cap) {
-        size_t cap = q->cap ? 2 * q->cap : 16;
-        tk_query_pair *grown = realloc(q->pairs, cap * sizeof *grown);
-        if (!grown) {
-            q->failed = true;
-            return MHD_NO;
-        }
-        q->pairs = grown;
-        q->cap = cap;
-    }
-    q->pairs[q->n++] = (tk_query_pair){key, value};
-    return MHD_YES;
-}
-
-static mhd_result submit(tk_api *a, struct MHD_Connection *c, const char *name,
-                         const tk_job_options *opts, const char *vect, size_t len)
-{
+    tk_pool_stats s;
+    tk_pool_stats_get(a->pool, &s);
+    size_t counts[TK_JOB_STATES];
     tk_error err;
-    tk_vect_limits limits = TK_VECT_LIMITS_INIT;
-    limits.max_vertices = a->cfg.max_vertices;
-    tk_curve *curve = NULL;
-    if (tk_vect_parse(vect, len, &limits, &curve, &err) != TK_OK)
-        return send_input_error(a, c, &err, NULL);
-    /* the reader refuses a NUL anywhere, so the text is a C string */
-    tk_job job;
-    int rc = tk_jobs_submit(a->jobs, name, opts, curve, vect, &job, &err);
-    tk_curve_free(&curve);
-    if (rc == TK_EBUSY) {
-        const char *headers[] = {MHD_HTTP_HEADER_RETRY_AFTER, "30", NULL};
-        return send_problem_ext(a, c, atomic_load(&a->refusing) ? 503 : 429, NULL, headers, "%s",
-                                err.message);
-    }
-    /* The submission starts a run to see that one can start: when the
-     * engine cannot make the start feasible (TK_ENUMERIC), or its
-     * resampling would change the knot type (TK_ETYPE: too few vertices
-     * per unit ropelength), that is this input's doing, not a fault of
-     * the service. */
-    if (rc == TK_EINVAL || rc == TK_ELIMIT || rc == TK_EPARSE || rc == TK_ENUMERIC ||
-        rc == TK_ETYPE)
-        return send_input_error(a, c, &err, NULL);
+    int rc = tk_store_counts(a->store, counts, &err);
     if (rc)
-        return send_problem(a, c, 500, "%s", err.message);
-    char location[64];
-    snprintf(location, sizeof location, "/v1/jobs/%lld", (long long)job.id);
-    const char *headers[] = {MHD_HTTP_HEADER_LOCATION, location, NULL};
-    return send_job(a, c, 202, &job, headers);
+        return store_problem(a, c, rc, &err);
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (!f)
+        return MHD_NO;
+    fputs("# HELP tightknot_jobs Jobs in the store by state.\n# TYPE tightknot_jobs gauge\n", f);
+    for (int i = 0; i < TK_JOB_STATES; i++)
+        fprintf(f, "tightknot_jobs{state=\"%s\"} %zu\n", tk_job_states[i], counts[i]);
+    const struct { const char *name, *type, *help; double value; } gauges[] = {
+        {"queue_length", "gauge", "Jobs waiting for a worker.", (double)counts[TK_JOB_QUEUED]},
+        {"queue_limit", "gauge", "Queued jobs beyond which submissions get 429.",
+         (double)s.queue_limit},
+        {"workers", "gauge", "Worker threads.", (double)s.workers},
+        {"workers_busy", "gauge", "Workers running a job.", (double)s.running},
+        {"steps_total", "counter", "Flow steps taken since start.", (double)s.steps_total},
+        {"steps_per_second", "gauge", "Steps per second over the running jobs.",
+         s.steps_per_second},
+        {"http_body_bytes_held", "gauge",
+         "Bytes of request bodies held now, all connections (at most --max-body-total).",
+         (double)atomic_load(&a->held)}};
+    for (size_t i = 0; i < sizeof gauges / sizeof gauges[0]; i++)
+        fprintf(f, "# HELP tightknot_%s %s\n# TYPE tightknot_%s %s\ntightknot_%s %.17g\n",
+                gauges[i].name, gauges[i].help, gauges[i].name, gauges[i].type, gauges[i].name,
+                gauges[i].value);
+    fputs("# HELP tightknot_http_responses_total HTTP responses by status class.\n"
+          "# TYPE tightknot_http_responses_total counter\n", f);
+    for (int i = 0; i < 4; i++)
+        fprintf(f, "tightknot_http_responses_total{code=\"%dxx\"} %llu\n", i + 2,
+                atomic_load(&a->responses[i]));
+    fclose(f);
+    return send_buffer(a, c, 200, "text/plain; version=0.0.4; charset=utf-8", buf, len, NULL);
 }
 
-static mhd_result post_job(tk_api *a, struct MHD_Connection *c, const request *rq)
+static result get_catalogue(tk_api *a, conn *c, const char *name)
 {
-    const char *type =
-        MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
-    query_list q = {0};
-    MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, collect_query, &q);
-    if (q.failed) {
-        free(q.pairs);
-        return send_problem(a, c, 500, "out of memory reading the query");
-    }
-    tk_submission sub;
-    tk_submission_problem p;
-    int rc = tk_submission_decode(type, q.pairs, q.n, rq->body, rq->len, a->cfg.catalogue,
-                                  &sub, &p);
-    free(q.pairs);
-    if (rc) {
-        if (p.status == 0)
-            return send_problem(a, c, 500, "%s", p.detail);
-        json_t *extra = p.member[0] ? json_pack("{s:s}", p.member, p.value) : NULL;
-        return send_problem_ext(a, c, p.status, extra, NULL, "%s", p.detail);
-    }
-    mhd_result ret = submit(a, c, sub.name, &sub.options, sub.vect, sub.len);
-    tk_submission_clear(&sub);
-    return ret;
+    if (!a->cfg.catalogue)
+        return PROBLEM(a, c, 404, "this server has no catalogue (start it with --catalogue)");
+    const entry *e = name ? find_entry(a, name) : NULL;
+    if (name && !e)
+        return PROBLEM(a, c, 404, "the catalogue has no knot '%.80s'", name);
+    json_t *list = json_array();
+    for (size_t i = 0; !name && i < a->nentries; i++)
+        json_array_append_new(list, json_pack("{s:s, s:I, s:I}", "name", a->entries[i].name,
+                                              "components", (json_int_t)a->entries[i].components,
+                                              "vertices", (json_int_t)a->entries[i].vertices));
+    if (!name)
+        return send_json(a, c, 200, json_pack("{s:I, s:o}", "count", (json_int_t)a->nentries,
+                                              "knots", list), NULL, NULL);
+    json_decref(list);
+    size_t len = 0;
+    char *text = read_file(a->cfg.catalogue, name, ".vect", &len);
+    json_t *o = text ? json_pack("{s:s, s:I, s:I, s:s%}", "name", e->name, "components",
+                                 (json_int_t)e->components, "vertices", (json_int_t)e->vertices,
+                                 "vect", text, len) : NULL;
+    free(text);
+    if (!o)
+        return PROBLEM(a, c, 500, "the catalogue file '%.80s' cannot be read as text", name);
+    return send_json(a, c, 200, o, NULL, NULL);
 }
 
-/* ---- the page's files ---- */
-
-static const char *content_type_of(const char *path)
+static result get_static(tk_api *a, conn *c, const char *url)
 {
-    const char *dot = strrchr(path, '.');
-    if (!dot)
-        return "application/octet-stream";
-    if (!strcmp(dot, ".html"))
-        return "text/html; charset=utf-8";
-    if (!strcmp(dot, ".js") || !strcmp(dot, ".mjs"))
-        return "text/javascript; charset=utf-8";
-    if (!strcmp(dot, ".css"))
-        return "text/css; charset=utf-8";
-    if (!strcmp(dot, ".svg"))
-        return "image/svg+xml";
-    if (!strcmp(dot, ".png"))
-        return "image/png";
-    if (!strcmp(dot, ".json"))
-        return "application/json";
-    if (!strcmp(dot, ".vect") || !strcmp(dot, ".txt"))
-        return "text/plain; charset=utf-8";
-    return "application/octet-stream";
-}
-
-static mhd_result get_static(tk_api *a, struct MHD_Connection *c, const char *url)
-{
+    static const char *const types[][2] = {
+        {".html", "text/html; charset=utf-8"}, {".js", "text/javascript; charset=utf-8"},
+        {".mjs", "text/javascript; charset=utf-8"}, {".css", "text/css; charset=utf-8"},
+        {".svg", "image/svg+xml"}, {".png", "image/png"}, {".json", "application/json"},
+        {".vect", "text/plain; charset=utf-8"}, {".txt", "text/plain; charset=utf-8"}};
     if (!a->web)
-        return send_problem(a, c, 404, "no page here: this server was started without --web");
-    const char *rel = strcmp(url, "/") == 0 ? "/index.html" : url;
-    /* Plain names below the root only: the path must start with its own
-     * separator (the root is joined to it as a directory, so ".bak/x" never
-     * reaches a neighbour "web.bak"), with no parent steps and no hidden
-     * files. */
+        return PROBLEM(a, c, 404, "no page here: this server was started without --web");
+    const char *rel = strcmp(url, "/") ? url : "/index.html";
+    /* plain names below the root: no parent steps, no hidden files (the
+     * root is joined as a directory, so no neighbour "web.bak" either) */
     if (rel[0] != '/' || strstr(rel, "/.") || strstr(rel, "..") || strchr(rel, '\\') ||
         strlen(rel) > 512)
-        return send_problem(a, c, 404, "no such file");
+        return PROBLEM(a, c, 404, "no such file");
     char path[1200];
     snprintf(path, sizeof path, "%s%s", a->web, rel);
     int fd = open(path, O_RDONLY | O_CLOEXEC);
     struct stat st;
-    if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    if (fd < 0 || fstat(fd, &st) || !S_ISREG(st.st_mode)) {
         if (fd >= 0)
             close(fd);
-        return send_problem(a, c, 404, "no such file: %.200s", url);
+        return PROBLEM(a, c, 404, "no such file: %.200s", url);
     }
     struct MHD_Response *r = MHD_create_response_from_fd((uint64_t)st.st_size, fd);
+    const char *dot = strrchr(path, '.'), *type = "application/octet-stream";
+    for (size_t i = 0; dot && i < sizeof types / sizeof types[0]; i++)
+        type = strcmp(dot, types[i][0]) ? type : types[i][1];
     if (!r) {
         close(fd);
         return MHD_NO;
     }
-    MHD_add_response_header(r, MHD_HTTP_HEADER_CONTENT_TYPE, content_type_of(path));
+    MHD_add_response_header(r, MHD_HTTP_HEADER_CONTENT_TYPE, type);
     MHD_add_response_header(r, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
-    mhd_result ret = MHD_queue_response(c, 200, r);
+    result ret = MHD_queue_response(c, 200, r);
     MHD_destroy_response(r);
-    atomic_fetch_add(&a->requests[CLASS_2XX], 1);
+    atomic_fetch_add(&a->responses[0], 1);
     return ret;
 }
 
 /* ---- routing ---- */
 
-static mhd_result method_not_allowed(tk_api *a, struct MHD_Connection *c, const char *allow,
-                                     const char *method)
-{
-    const char *headers[] = {MHD_HTTP_HEADER_ALLOW, allow, NULL};
-    return send_problem_ext(a, c, 405, NULL, headers, "%s is not allowed here; use %s", method,
-                            allow);
-}
-
-/* Parses "/v1/jobs/{id}[/part]"; false when the id is not a number. */
-static bool parse_job_path(const char *rest, int64_t *id, const char **part)
-{
-    char *end = NULL;
-    if (!isdigit((unsigned char)rest[0]))
-        return false;
-    errno = 0;
-    long long n = strtoll(rest, &end, 10);
-    if (errno || n <= 0)
-        return false;
-    *id = n;
-    if (*end == '\0') {
-        *part = "";
-        return true;
-    }
-    if (*end != '/')
-        return false;
-    *part = end + 1;
-    return true;
-}
-
-static mhd_result route(tk_api *a, struct MHD_Connection *c, const char *url,
-                        const char *method, const request *rq)
+static result route(tk_api *a, conn *c, const char *url, const char *method, const request *rq)
 {
     bool get = !strcmp(method, "GET") || !strcmp(method, "HEAD");
-    if (!strcmp(url, "/v1/health"))
-        return get ? get_health(a, c) : method_not_allowed(a, c, "GET", method);
-    if (!strcmp(url, "/metrics"))
-        return get ? get_metrics(a, c) : method_not_allowed(a, c, "GET", method);
-    if (!strcmp(url, "/v1/catalogue"))
-        return get ? get_catalogue(a, c) : method_not_allowed(a, c, "GET", method);
-    if (!strncmp(url, "/v1/catalogue/", 14))
-        return get ? get_catalogue_entry(a, c, url + 14) : method_not_allowed(a, c, "GET", method);
+    const char *allow = "GET";
+    if (!strcmp(url, "/v1/jobs") && !strcmp(method, "POST"))
+        return post_job(a, c, rq);
     if (!strcmp(url, "/v1/jobs")) {
+        allow = "GET, POST";
         if (get)
             return list_jobs(a, c);
-        if (!strcmp(method, "POST"))
-            return post_job(a, c, rq);
-        return method_not_allowed(a, c, "GET, POST", method);
-    }
-    if (!strncmp(url, "/v1/jobs/", 9)) {
-        int64_t id = 0;
-        const char *part = NULL;
-        if (!parse_job_path(url + 9, &id, &part))
-            return send_problem(a, c, 404, "no such resource: %.200s (job ids are positive "
-                                           "whole numbers)",
-                                url);
-        bool known = !*part || !strcmp(part, "struts") || !strcmp(part, "vect") ||
-                     !strcmp(part, "history") || !strcmp(part, "frames");
-        if (!known)
-            return send_problem(a, c, 404, "no such resource: %.200s", url);
-        if (!*part && !strcmp(method, "DELETE"))
+    } else if (!strncmp(url, "/v1/jobs/", 9)) {
+        char *end = NULL;
+        errno = 0;
+        long long id = url[9] >= '0' && url[9] <= '9' ? strtoll(url + 9, &end, 10) : 0;
+        const char *part = end && *end == '/' ? end + 1 : "";
+        if (errno || id <= 0 || (*end && *end != '/'))
+            return PROBLEM(a, c, 404, "no such resource: %.200s (job ids are positive whole "
+                           "numbers)", url);
+        static const char *const parts[] = {"", "struts", "vect", "history", "frames"};
+        int k = 0;
+        while (k < 5 && strcmp(part, parts[k]))
+            k++;
+        if (k == 5)
+            return PROBLEM(a, c, 404, "no such resource: %.200s", url);
+        if (k == 0 && !strcmp(method, "DELETE"))
             return cancel_job(a, c, id);
-        if (!get)
-            return method_not_allowed(a, c, *part ? "GET" : "GET, DELETE", method);
-        tk_job job;
-        mhd_result ret = MHD_NO;
-        if (!find_job(a, c, id, &job, &ret))
+        allow = k ? "GET" : "GET, DELETE";
+        json_t *doc = NULL;
+        tk_error err;
+        int rc = get ? get_job(a, id, &doc, &err) : TK_OK;
+        if (rc)
+            return store_problem(a, c, rc, &err);
+        if (get) {
+            result ret = k == 0 ? send_json(a, c, 200, with_links(json_incref(doc)), NULL, NULL)
+                         : k == 1 ? get_struts(a, c, doc)
+                         : k == 2 ? get_vect(a, c, doc)
+                         : k == 3 ? get_history(a, c, doc)
+                                  : get_frames(a, c, doc);
+            json_decref(doc);
             return ret;
-        if (!*part)
-            return send_job(a, c, 200, &job, NULL);
-        if (!strcmp(part, "struts"))
-            return get_job_text_json(a, c, &job, TK_TEXT_CONTACTS);
-        if (!strcmp(part, "history"))
-            return get_job_text_json(a, c, &job, TK_TEXT_HISTORY);
-        if (!strcmp(part, "vect"))
-            return get_job_vect(a, c, &job);
-        return get_job_frames(a, c, &job);
+        }
+    } else if (!strcmp(url, "/v1/health") && get) {
+        return get_health(a, c);
+    } else if (!strcmp(url, "/metrics") && get) {
+        return get_metrics(a, c);
+    } else if (!strcmp(url, "/v1/catalogue") && get) {
+        return get_catalogue(a, c, NULL);
+    } else if (!strncmp(url, "/v1/catalogue/", 14) && get) {
+        return get_catalogue(a, c, url + 14);
+    } else if (!strncmp(url, "/v1/", 4) || !strcmp(url, "/v1")) {
+        if (strcmp(url, "/v1/health") && strcmp(url, "/v1/catalogue") &&
+            strncmp(url, "/v1/catalogue/", 14))
+            return PROBLEM(a, c, 404, "no such resource: %.200s", url);
+    } else if (get) {
+        return get_static(a, c, url);
     }
-    if (!strncmp(url, "/v1/", 4) || !strcmp(url, "/v1"))
-        return send_problem(a, c, 404, "no such resource: %.200s", url);
-    return get ? get_static(a, c, url) : method_not_allowed(a, c, "GET", method);
+    const char *headers[] = {MHD_HTTP_HEADER_ALLOW, allow, NULL};
+    return problem(a, c, 405, NULL, headers, "%s is not allowed here; use %s", method, allow);
 }
 
-static mhd_result handle(void *cls, struct MHD_Connection *c, const char *url,
-                         const char *method, const char *version, const char *upload_data,
-                         size_t *upload_data_size, void **con_cls)
+static void drop_body(tk_api *a, request *rq)
+{
+    atomic_fetch_sub(&a->held, rq->cap);
+    free(rq->body);
+    rq->body = NULL;
+    rq->len = rq->cap = 0;
+}
+
+/* Reads a POST's body within max_body, all bodies at once within
+ * max_body_total (held uploads cannot take the daemon's memory); skips
+ * any other method's body; then answers. */
+static result handle(void *cls, conn *c, const char *url, const char *method,
+                     const char *version, const char *data, size_t *size, void **con_cls)
 {
     (void)version;
     tk_api *a = cls;
     request *rq = *con_cls;
-    /* only POST reads its body; any other method's body is skipped */
-    bool wants_body = !strcmp(method, "POST");
+    bool post = !strcmp(method, "POST");
     if (!rq) {
-        rq = calloc(1, sizeof *rq);
-        if (!rq)
+        if (!(*con_cls = rq = calloc(1, sizeof *rq)))
             return MHD_NO;
-        *con_cls = rq;
-        /* refuse a declared oversized body before reading it */
-        const char *length =
-            MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
-        if (wants_body && length && strtoull(length, NULL, 10) > a->cfg.max_body)
-            rq->too_large = true;
-        if (rq->too_large || atomic_load(&a->refusing))
-            goto answer;
-        return MHD_YES;
-    }
-    if (*upload_data_size > 0) {
-        if (!wants_body) {
-            *upload_data_size = 0;
+        const char *length = MHD_lookup_connection_value(c, MHD_HEADER_KIND,
+                                                         MHD_HTTP_HEADER_CONTENT_LENGTH);
+        rq->too_large = post && length && strtoull(length, NULL, 10) > a->cfg.max_body;
+        if (!rq->too_large && !atomic_load(&a->refusing))
             return MHD_YES;
-        }
-        if (!rq->too_large && rq->len + *upload_data_size > a->cfg.max_body) {
+    } else if (*size > 0) {
+        if (post && !rq->too_large && rq->len + *size > a->cfg.max_body) {
             rq->too_large = true;
             drop_body(a, rq);
         }
-        if (!rq->too_large && !rq->crowded) {
-            if (rq->len + *upload_data_size + 1 > rq->cap) {
-                size_t cap = rq->cap ? rq->cap : 65536;
-                while (cap < rq->len + *upload_data_size + 1)
-                    cap *= 2;
-                /* Every body is bounded by max_body, and all of them at
-                 * once by max_body_total: held uploads cannot take the
-                 * daemon's memory, whatever their number. */
-                size_t more = cap - rq->cap;
-                if (atomic_fetch_add(&a->buffered, more) + more > a->cfg.max_body_total) {
-                    atomic_fetch_sub(&a->buffered, more);
-                    rq->crowded = true;
-                    drop_body(a, rq);
-                    *upload_data_size = 0;
-                    return MHD_YES;
-                }
-                char *grown = realloc(rq->body, cap);
-                if (!grown) {
-                    atomic_fetch_sub(&a->buffered, more);
-                    return MHD_NO;
-                }
+        if (post && !rq->too_large && !rq->crowded && rq->len + *size + 1 > rq->cap) {
+            size_t cap = rq->cap ? rq->cap : 65536;
+            while (cap < rq->len + *size + 1)
+                cap *= 2;
+            size_t more = cap - rq->cap;
+            char *grown = atomic_fetch_add(&a->held, more) + more > a->cfg.max_body_total
+                              ? NULL
+                              : realloc(rq->body, cap);
+            if (!grown) {
+                atomic_fetch_sub(&a->held, more);
+                rq->crowded = true;
+                drop_body(a, rq);
+            } else {
                 rq->body = grown;
                 rq->cap = cap;
             }
-            memcpy(rq->body + rq->len, upload_data, *upload_data_size);
-            rq->len += *upload_data_size;
+        }
+        if (post && !rq->too_large && !rq->crowded) {
+            memcpy(rq->body + rq->len, data, *size);
+            rq->len += *size;
             rq->body[rq->len] = '\0';
         }
-        *upload_data_size = 0;
+        *size = 0;
         return MHD_YES;
     }
-answer:
     if (atomic_load(&a->refusing)) {
         const char *headers[] = {MHD_HTTP_HEADER_RETRY_AFTER, "10", NULL};
-        return send_problem_ext(a, c, 503, NULL, headers, "the service is shutting down");
+        return problem(a, c, 503, NULL, headers, "the service is shutting down");
     }
     if (rq->too_large)
-        return send_problem(a, c, 413, "the request body is larger than the limit of %zu bytes",
-                            a->cfg.max_body);
+        return PROBLEM(a, c, 413, "the request body is larger than the limit of %zu bytes",
+                       a->cfg.max_body);
     if (rq->crowded) {
         const char *headers[] = {MHD_HTTP_HEADER_RETRY_AFTER, "5", NULL};
-        return send_problem_ext(a, c, 503, NULL, headers,
-                                "too many uploads at once (%zu bytes held): try again shortly",
-                                a->cfg.max_body_total);
+        return problem(a, c, 503, NULL, headers, "too many uploads at once (%zu bytes held): "
+                       "try again shortly", a->cfg.max_body_total);
     }
     return route(a, c, url, method, rq);
 }
 
-static void request_done(void *cls, struct MHD_Connection *c, void **con_cls,
-                         enum MHD_RequestTerminationCode toe)
+static void request_done(void *cls, conn *c, void **con_cls, enum MHD_RequestTerminationCode toe)
 {
-    (void)c;
-    (void)toe;
-    request *rq = *con_cls;
-    if (rq) {
-        drop_body(cls, rq);
-        free(rq);
+    (void)c, (void)toe;
+    if (*con_cls) {
+        drop_body(cls, *con_cls);
+        free(*con_cls);
         *con_cls = NULL;
     }
 }
 
-int tk_api_start(const tk_api_config *cfg, tk_jobs *jobs, tk_store *store, tk_api **out,
+/* ---- submissions ---- */
+
+__attribute__((format(printf, 5, 6))) static int refuse(tk_problem *p, unsigned status,
+                                                        const char *member, const char *value,
+                                                        const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(p->detail, sizeof p->detail, fmt, ap);
+    va_end(ap);
+    p->status = status;
+    snprintf(p->member, sizeof p->member, "%s", member ? member : "");
+    snprintf(p->value, sizeof p->value, "%s", value ? value : "");
+    return status == 400 ? TK_EPARSE : TK_EINVAL;
+}
+
+static bool media_is(const char *type, const char *media)
+{
+    size_t n = strlen(media);
+    return type && !strncasecmp(type, media, n) && strchr("; ", type[n]);
+}
+
+/* A name is shown as a JSON string: UTF-8, no NUL, under 128 bytes. */
+static int set_name(tk_submission *out, const json_t *name, tk_problem *p)
+{
+    if (!json_is_string(name) || json_string_length(name) > 127 ||
+        strlen(json_string_value(name)) != json_string_length(name))
+        return refuse(p, 422, "field", "name", "'name' must be text (UTF-8, no NUL) under 128 "
+                      "bytes");
+    out->name = json_string_value(name);
+    return TK_OK;
+}
+
+static int decode_json(const char *body, size_t len, tk_submission *out, tk_problem *p)
+{
+    json_error_t jerr;
+    json_t *doc = out->json = json_loadb(body, len, JSON_REJECT_DUPLICATES, &jerr);
+    if (!doc)
+        return refuse(p, 400, NULL, NULL, "the body is not valid JSON: %s (line %d, column %d)",
+                      jerr.text, jerr.line, jerr.column);
+    if (!json_is_object(doc))
+        return refuse(p, 422, NULL, NULL, "the body must be a JSON object");
+    const char *key;
+    json_t *value;
+    json_object_foreach(doc, key, value)
+        if (strcmp(key, "vect") && strcmp(key, "catalogue") && strcmp(key, "name") &&
+            strcmp(key, "options"))
+            return refuse(p, 422, "field", key, "unknown field '%.60s' (expected vect or "
+                          "catalogue, name, options)", key);
+    json_t *vect = json_object_get(doc, "vect"), *cat = json_object_get(doc, "catalogue");
+    json_t *name = json_object_get(doc, "name"), *options = json_object_get(doc, "options");
+    if (!vect == !cat)
+        return refuse(p, 422, NULL, NULL, "give exactly one of 'vect' (the VECT text) and "
+                      "'catalogue' (a knot name from GET /v1/catalogue)");
+    const char *bad = vect && !json_is_string(vect)     ? "vect"
+                      : cat && !json_is_string(cat)     ? "catalogue"
+                      : name && !json_is_string(name)   ? "name"
+                                                        : NULL;
+    if (bad)
+        return refuse(p, 422, "field", bad, "'%s' must be a string", bad);
+    int rc = name || cat ? set_name(out, name ? name : cat, p) : TK_OK;
+    tk_error err;
+    if (!rc && options && tk_job_options_from_json(&out->options, options, &bad, &err))
+        return refuse(p, 422, bad ? "option" : NULL, bad, "%s", err.message);
+    out->vect = json_string_value(vect);
+    out->len = json_string_length(vect);
+    out->catalogue = json_string_value(cat);
+    return rc;
+}
+
+int tk_submission_decode(const char *content_type, const tk_query_pair *query, size_t nquery,
+                         const char *body, size_t len, tk_submission *out, tk_problem *p)
+{
+    memset(p, 0, sizeof *p);
+    *out = (tk_submission){.name = "untitled", .options = TK_JOB_OPTIONS_INIT, .vect = body,
+                           .len = len};
+    int rc = TK_OK;
+    tk_error err;
+    if (media_is(content_type, "application/json")) {
+        rc = decode_json(body ? body : "", len, out, p);
+    } else if (!media_is(content_type, "text/plain")) {
+        rc = refuse(p, 415, NULL, NULL, "send application/json ({\"vect\": ...} or "
+                    "{\"catalogue\": ...}) or text/plain (a VECT file, options in the query); "
+                    "got %.80s", content_type ? content_type : "no Content-Type");
+    }
+    for (size_t i = 0; !rc && !out->json && i < nquery; i++) {
+        const char *key = query[i].key, *value = query[i].value ? query[i].value : "";
+        json_t *name = strcmp(key, "name") ? NULL : json_string(value);
+        if (name) { /* kept with the submission */
+            out->json = json_pack("{s:o}", "name", name);
+            rc = set_name(out, json_object_get(out->json, "name"), p);
+        } else if (!strcmp(key, "name")) {
+            rc = refuse(p, 422, "field", "name", "'name' must be text (UTF-8, no NUL) under 128 "
+                        "bytes");
+        } else if (tk_job_option_set_text(&out->options, key, value, &err)) {
+            rc = refuse(p, 422, "option", key, "%s", err.message);
+        }
+    }
+    if (rc)
+        tk_submission_clear(out);
+    return rc;
+}
+
+void tk_submission_clear(tk_submission *s)
+{
+    json_decref(s->json);
+    *s = (tk_submission){NULL};
+}
+
+/* ---- start and stop ---- */
+
+static int by_name(const void *x, const void *y)
+{
+    return strcmp(((const entry *)x)->name, ((const entry *)y)->name);
+}
+
+/* Reads the catalogue's *.vect files once (a file that does not parse is
+ * left out). */
+static void load_catalogue(tk_api *a)
+{
+    DIR *d = opendir(a->cfg.catalogue);
+    struct dirent *e;
+    while (d && (e = readdir(d)) != NULL) {
+        size_t n = strlen(e->d_name), len = 0;
+        if (n < 6 || strcmp(e->d_name + n - 5, ".vect") || e->d_name[0] == '.')
+            continue;
+        char *name = strndup(e->d_name, n - 5);
+        char *text = name ? read_file(a->cfg.catalogue, name, ".vect", &len) : NULL;
+        tk_curve *curve = NULL;
+        entry *grown = text && !tk_vect_parse(text, len, NULL, &curve, NULL)
+                           ? realloc(a->entries, (a->nentries + 1) * sizeof *grown)
+                           : NULL;
+        if (grown) {
+            a->entries = grown;
+            a->entries[a->nentries++] = (entry){name, curve->ncomp, curve->nvert};
+        } else {
+            free(name);
+        }
+        tk_curve_free(&curve);
+        free(text);
+    }
+    if (d)
+        closedir(d);
+    if (a->entries)
+        qsort(a->entries, a->nentries, sizeof *a->entries, by_name);
+}
+
+int tk_api_start(const tk_api_config *cfg, tk_pool *pool, tk_store *store, tk_api **out,
                  tk_error *err)
 {
     *out = NULL;
-    struct sockaddr_in addr;
-    memset(&addr, 0, sizeof addr);
-    addr.sin_family = AF_INET;
-    addr.sin_port = htons((uint16_t)cfg->port);
+    struct sockaddr_in addr = {.sin_family = AF_INET, .sin_port = htons((uint16_t)cfg->port)};
     if (inet_pton(AF_INET, cfg->bind, &addr.sin_addr) != 1)
         return tk_error_set(err, TK_EINVAL, "--bind: '%s' is not an IPv4 address", cfg->bind);
+    DIR *probe = cfg->catalogue ? opendir(cfg->catalogue) : NULL;
+    if (cfg->catalogue && !probe)
+        return tk_error_set(err, TK_EIO, "--catalogue: cannot read %s: %s", cfg->catalogue,
+                            strerror(errno));
+    if (probe)
+        closedir(probe);
     tk_api *a = calloc(1, sizeof *a);
     if (!a)
         return tk_error_set(err, TK_ENOMEM, "out of memory");
-    a->cfg = *cfg;
-    a->jobs = jobs;
-    a->store = store;
-    a->started = now_unix();
-    atomic_init(&a->refusing, false);
-    atomic_init(&a->buffered, 0);
-    for (int i = 0; i < CLASSES; i++)
-        atomic_init(&a->requests[i], 0);
-    if (cfg->web) {
-        a->web = realpath(cfg->web, NULL);
-        if (!a->web) {
-            free(a);
-            return tk_error_set(err, TK_EIO, "--web: cannot use %s: %s", cfg->web,
-                                strerror(errno));
-        }
+    *a = (tk_api){.cfg = *cfg, .pool = pool, .store = store, .started = time(NULL)};
+    if (cfg->web && !(a->web = realpath(cfg->web, NULL))) {
+        tk_error_set(err, TK_EIO, "--web: cannot use %s: %s", cfg->web, strerror(errno));
+        tk_api_stop(&a);
+        return TK_EIO;
     }
-    unsigned threads = cfg->threads ? (unsigned)cfg->threads : 2;
+    if (cfg->catalogue)
+        load_catalogue(a);
     a->daemon = MHD_start_daemon(
         MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_EPOLL, 0, NULL, NULL, handle, a,
-        MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr, MHD_OPTION_THREAD_POOL_SIZE, threads,
-        MHD_OPTION_CONNECTION_LIMIT, (unsigned)cfg->max_connections,
-        MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg->max_per_address,
-        MHD_OPTION_CONNECTION_TIMEOUT, cfg->timeout, MHD_OPTION_NOTIFY_COMPLETED, request_done,
-        a, MHD_OPTION_LISTEN_BACKLOG_SIZE, 1024, MHD_OPTION_END);
+        MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr, MHD_OPTION_THREAD_POOL_SIZE,
+        (unsigned)(cfg->threads ? cfg->threads : 2), MHD_OPTION_CONNECTION_LIMIT,
+        (unsigned)cfg->max_connections, MHD_OPTION_PER_IP_CONNECTION_LIMIT,
+        (unsigned)cfg->max_per_address, MHD_OPTION_CONNECTION_TIMEOUT, cfg->timeout,
+        MHD_OPTION_NOTIFY_COMPLETED, request_done, a, MHD_OPTION_LISTEN_BACKLOG_SIZE, 1024,
+        MHD_OPTION_END);
     if (!a->daemon) {
-        int e = errno;
-        free(a->web);
-        free(a);
-        return tk_error_set(err, TK_EIO, "cannot listen on %s:%u: %s", cfg->bind, cfg->port,
-                            e ? strerror(e) : "unknown error");
+        tk_error_set(err, TK_EIO, "cannot listen on %s:%u: %s", cfg->bind, cfg->port,
+                     errno ? strerror(errno) : "unknown error");
+        tk_api_stop(&a);
+        return TK_EIO;
     }
     *out = a;
     return TK_OK;
@@ -1027,9 +950,14 @@ int tk_api_start(const tk_api_config *cfg, tk_jobs *jobs, tk_store *store, tk_ap
 
 unsigned tk_api_port(const tk_api *a)
 {
-    const union MHD_DaemonInfo *info =
-        MHD_get_daemon_info(a->daemon, MHD_DAEMON_INFO_BIND_PORT);
+    const union MHD_DaemonInfo *info = MHD_get_daemon_info(a->daemon,
+                                                           MHD_DAEMON_INFO_BIND_PORT);
     return info ? info->port : a->cfg.port;
+}
+
+size_t tk_api_catalogue_size(const tk_api *a)
+{
+    return a->nentries;
 }
 
 void tk_api_refuse(tk_api *a)
@@ -1041,7 +969,11 @@ void tk_api_stop(tk_api **p)
 {
     if (!p || !*p)
         return;
-    MHD_stop_daemon((*p)->daemon);
+    if ((*p)->daemon)
+        MHD_stop_daemon((*p)->daemon);
+    for (size_t i = 0; i < (*p)->nentries; i++)
+        free((*p)->entries[i].name);
+    free((*p)->entries);
     free((*p)->web);
     free(*p);
     *p = NULL;

@@ -1,18 +1,21 @@
-/* Tests for the SQLite job store (server/store.c): what is stored reads
- * back the same after closing and opening the file again, listing is
- * newest first with a filter and pages, frames come back bit for bit, and
- * the unfinished jobs are the queued and running ones, oldest first; a
- * store written before the invariants column gets it and keeps its jobs. */
+/* Tests for the SQLite job store (server/store.c): a job's document,
+ * parts and frames read back the same after the file is opened again;
+ * listing is newest first with a filter and pages; the queue is the store
+ * (claims take the oldest queued job, each exactly once, from many
+ * threads; the limit holds); cancelling, deleting and queueing again
+ * change only the jobs they may; a reader never waits for a writer; a
+ * store of the first version becomes documents and keeps its jobs. */
 #include <check.h>
-#include <math.h>
+#include <pthread.h>
 #include <sqlite3.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "jsonmap.h"
+#include "store.h"
 #include "support.h"
-#include "tk/store.h"
 
 static char dir[64];
 static char path[128];
@@ -43,114 +46,87 @@ static tk_store *open_store(void)
     return s;
 }
 
-static int64_t add_job(tk_store *s, const char *name, tk_job_state state)
+static const char input[] = "VECT\n1 3 0\n-3\n0\n0 0 0\n1 0 0\n0 1 0\n";
+
+/* Adds a queued job called name; its id. */
+static int64_t add_job(tk_store *s, const char *name)
 {
-    tk_job j;
-    memset(&j, 0, sizeof j);
-    snprintf(j.name, sizeof j.name, "%s", name);
-    j.state = state;
     tk_job_options o = TK_JOB_OPTIONS_INIT;
     o.run.max_steps = 77;
-    o.run.resolution = 5;
-    j.options = o;
-    j.created = 1.7e9;
+    json_t *doc = tk_job_new(name, &o, 1, 3);
     tk_error err;
-    ck_assert_msg(tk_store_insert(s, &j, "VECT\n1 3 0\n-3\n0\n0 0 0\n1 0 0\n0 1 0\n", &err) ==
-                      TK_OK,
-                  "%s", err.message);
-    ck_assert_int_gt(j.id, 0);
-    j.fraction = -1.0;
-    ck_assert_int_eq(tk_store_update(s, &j, &err), TK_OK);
-    return j.id;
+    ck_assert_msg(tk_store_add(s, doc, input, 1000, &err) == TK_OK, "%s", err.message);
+    int64_t id = tk_job_id(doc);
+    ck_assert_int_gt(id, 0);
+    json_decref(doc);
+    return id;
+}
+
+static json_t *get(tk_store *s, int64_t id)
+{
+    json_t *doc = NULL;
+    tk_error err;
+    ck_assert_msg(tk_store_get(s, id, &doc, &err) == TK_OK, "%s", err.message);
+    return doc;
+}
+
+static const char *state_of(tk_store *s, int64_t id)
+{
+    json_t *doc = get(s, id);
+    const char *name = tk_job_states[tk_job_state_in(doc)];
+    json_decref(doc);
+    return name;
 }
 
 START_TEST(a_job_reads_back_after_reopening)
 {
     tk_store *s = open_store();
-    int64_t id = add_job(s, "trefoil", TK_JOB_QUEUED);
-    tk_job j;
+    int64_t id = add_job(s, "trefoil");
+    json_t *doc = get(s, id);
+    ck_assert_str_eq(json_string_value(json_object_get(doc, "name")), "trefoil");
+    ck_assert_str_eq(json_string_value(json_object_get(doc, "state")), "queued");
+    tk_step_report r = {.step = 77, .seconds = 1.25, .ropelength = 32.7523560914,
+                        .thickness = 1.0, .residual = 0.1 / 3.0, .vertices = 3};
+    tk_job_options o;
     tk_error err;
-    ck_assert_int_eq(tk_store_get(s, id, &j, &err), TK_OK);
-    j.state = TK_JOB_DONE;
-    j.started = 1.7e9 + 1.0;
-    j.finished = 1.7e9 + 2.5;
-    j.has_figures = true;
-    j.latest.step = 77;
-    j.latest.seconds = 1.25;
-    j.latest.ropelength = 32.7523560914;
-    j.latest.thickness = 1.0;
-    j.latest.length = 16.3761780457;
-    j.latest.minrad = 0.6;
-    j.latest.residual = 0.01;
-    j.latest.struts = 12;
-    j.latest.kinks = 1;
-    j.latest.vertices = 184;
-    j.components = 1;
-    j.fraction = 1.0;
-    snprintf(j.stop_reason, sizeof j.stop_reason, "steps");
-    double xyz[2][9];
-    for (int f = 0; f < 2; f++)
-        for (int k = 0; k < 9; k++)
-            xyz[f][k] = sin(1.0 + f * 9 + k) / 3.0; /* not short decimals */
-    /* frames of two layouts: one stored before frames had their own */
-    tk_store_frame frames[2] = {{10, xyz[0], 9, NULL}, {20, xyz[1], 6, (char *)"[2]"}};
-    j.frames = 2;
-    char *none = (char *)"not read";
-    ck_assert_int_eq(tk_store_text(s, id, TK_TEXT_INVARIANTS, &none, NULL, &err), TK_OK);
-    ck_assert_ptr_null(none); /* before the run starts */
-    const char *type = "{\"start\":{\"determinants\":[3]},\"result\":null}";
-    const char *texts[TK_TEXTS] = {NULL, "VECT curve", "{\"struts\":[]}", "[]", type,
-                                   "{\"at\":{}}"};
-    ck_assert_int_eq(tk_store_save(s, &j, texts, frames, 2, &err), TK_OK);
+    ck_assert_int_eq(tk_job_options_of(doc, &o, &err), TK_OK);
+    ck_assert_int_eq(o.run.max_steps, 77);
+    tk_job_set_figures(doc, &r, &o);
+    json_object_set_new(doc, "state", json_string("done"));
+    const char *parts[TK_PARTS] = {NULL, "VECT curve", "{\"struts\":[]}", "[1,2]", "{}"};
+    double xyz[2][6] = {{0.1, 1.0 / 3.0, -2.5, 4, 5, 6}, {1e-300, 2, 3, 4, 5, 6}};
+    tk_frame frames[2] = {{10, xyz[0], 6, "[2]"}, {20, xyz[1], 6, NULL}};
+    ck_assert_int_eq(tk_store_put(s, doc, parts, frames, 0, 2, &err), TK_OK);
     tk_store_close(&s);
 
     s = open_store();
-    tk_job back;
-    ck_assert_int_eq(tk_store_get(s, id, &back, &err), TK_OK);
-    ck_assert_str_eq(back.name, "trefoil");
-    ck_assert_int_eq(back.state, TK_JOB_DONE);
-    ck_assert_int_eq(back.options.run.max_steps, 77);
-    ck_assert(back.options.run.resolution == 5.0);
-    ck_assert(back.latest.ropelength == 32.7523560914);
-    ck_assert(back.latest.length == 16.3761780457);
-    ck_assert(back.started == 1.7e9 + 1.0 && back.finished == 1.7e9 + 2.5);
-    ck_assert_uint_eq(back.latest.struts, 12);
-    ck_assert_uint_eq(back.latest.vertices, 184);
-    ck_assert(back.has_figures);
-    ck_assert_str_eq(back.stop_reason, "steps");
-    ck_assert_str_eq(back.error, "");
-    ck_assert_uint_eq(back.frames, 2);
-    char *text = NULL;
-    ck_assert_int_eq(tk_store_text(s, id, TK_TEXT_CURVE, &text, NULL, &err), TK_OK);
-    ck_assert_str_eq(text, "VECT curve");
-    free(text);
-    ck_assert_int_eq(tk_store_text(s, id, TK_TEXT_INPUT, &text, NULL, &err), TK_OK);
-    ck_assert(strncmp(text, "VECT\n1 3 0", 10) == 0);
-    free(text);
-    ck_assert_int_eq(tk_store_text(s, id, TK_TEXT_INVARIANTS, &text, NULL, &err), TK_OK);
-    ck_assert_str_eq(text, type);
-    free(text);
-    ck_assert_int_eq(tk_store_text(s, id, TK_TEXT_RESUME, &text, NULL, &err), TK_OK);
-    ck_assert_str_eq(text, "{\"at\":{}}");
-    free(text);
-    tk_store_frame *back_frames = NULL;
+    json_t *back = get(s, id);
+    ck_assert_msg(json_equal(doc, back), "%s", json_dumps(back, 0));
+    for (int k = 0; k < TK_PARTS; k++) {
+        char *text = NULL;
+        ck_assert_int_eq(tk_store_part(s, id, (tk_part)k, &text, NULL, &err), TK_OK);
+        ck_assert_str_eq(text, k == TK_PART_INPUT ? input : parts[k]);
+        free(text);
+    }
+    tk_frame *f = NULL;
     size_t n = 0;
-    ck_assert_int_eq(tk_store_frames(s, id, 0, 5, &back_frames, &n, &err), TK_OK);
-    ck_assert_uint_eq(n, 2);
-    ck_assert_int_eq(back_frames[0].step, 10);
-    ck_assert_uint_eq(back_frames[0].count, 9);
-    ck_assert_ptr_null(back_frames[0].layout);
-    ck_assert(memcmp(back_frames[0].xyz, xyz[0], sizeof xyz[0]) == 0);
-    ck_assert_int_eq(back_frames[1].step, 20);
-    ck_assert_uint_eq(back_frames[1].count, 6);
-    ck_assert_str_eq(back_frames[1].layout, "[2]");
-    ck_assert(memcmp(back_frames[1].xyz, xyz[1], 6 * sizeof(double)) == 0);
-    tk_store_frames_free(back_frames, n);
-    /* a page from the middle */
-    ck_assert_int_eq(tk_store_frames(s, id, 1, 5, &back_frames, &n, &err), TK_OK);
+    ck_assert_int_eq(tk_store_frames(s, id, 1, 10, &f, &n, &err), TK_OK);
     ck_assert_uint_eq(n, 1);
-    ck_assert_int_eq(back_frames[0].step, 20);
-    tk_store_frames_free(back_frames, n);
+    ck_assert_int_eq(f[0].step, 20);
+    ck_assert_uint_eq(f[0].count, 6);
+    ck_assert(memcmp(f[0].xyz, xyz[1], sizeof xyz[1]) == 0);
+    ck_assert_ptr_null(f[0].layout);
+    tk_frames_free(f, n);
+    /* frames from a place on replace those after it */
+    frames[0].step = 15;
+    ck_assert_int_eq(tk_store_put(s, doc, NULL, frames, 1, 1, &err), TK_OK);
+    ck_assert_int_eq(tk_store_frames(s, id, 0, 10, &f, &n, &err), TK_OK);
+    ck_assert_uint_eq(n, 2);
+    ck_assert(f[0].step == 10 && f[1].step == 15 && !strcmp(f[1].layout, "[2]"));
+    ck_assert(memcmp(f[1].xyz, xyz[0], sizeof xyz[0]) == 0);
+    tk_frames_free(f, n);
+    json_decref(doc);
+    json_decref(back);
     tk_store_close(&s);
 }
 END_TEST
@@ -158,15 +134,14 @@ END_TEST
 START_TEST(missing_jobs_are_not_found)
 {
     tk_store *s = open_store();
-    tk_job j;
-    tk_error err;
-    ck_assert_int_eq(tk_store_get(s, 42, &j, &err), TK_ENOTFOUND);
-    ck_assert(strstr(err.message, "42"));
+    json_t *doc = NULL;
     char *text = NULL;
-    ck_assert_int_eq(tk_store_text(s, 42, TK_TEXT_INPUT, &text, NULL, &err), TK_ENOTFOUND);
-    memset(&j, 0, sizeof j);
-    j.id = 42;
-    ck_assert_int_eq(tk_store_update(s, &j, &err), TK_ENOTFOUND);
+    tk_error err;
+    ck_assert_int_eq(tk_store_get(s, 42, &doc, &err), TK_ENOTFOUND);
+    ck_assert(strstr(err.message, "42"));
+    ck_assert_int_eq(tk_store_part(s, 42, TK_PART_CURVE, &text, NULL, &err), TK_ENOTFOUND);
+    ck_assert_int_eq(tk_store_cancel(s, 42, &err), TK_EINVAL);
+    ck_assert_int_eq(tk_store_delete(s, 42, &err), TK_EINVAL);
     tk_store_close(&s);
 }
 END_TEST
@@ -175,52 +150,138 @@ START_TEST(listing_is_newest_first_filtered_and_paged)
 {
     tk_store *s = open_store();
     int64_t ids[7];
-    tk_job_state states[7] = {TK_JOB_DONE,    TK_JOB_QUEUED, TK_JOB_DONE,  TK_JOB_RUNNING,
-                              TK_JOB_FAILED,  TK_JOB_DONE,   TK_JOB_QUEUED};
-    for (int i = 0; i < 7; i++) {
-        char name[16];
-        snprintf(name, sizeof name, "k%d", i);
-        ids[i] = add_job(s, name, states[i]);
-    }
-    tk_job *jobs = NULL;
-    size_t n = 0, total = 0;
+    for (int i = 0; i < 7; i++)
+        ids[i] = add_job(s, "k");
     tk_error err;
-    ck_assert_int_eq(tk_store_list(s, false, 0, 0, 3, &jobs, &n, &total, &err), TK_OK);
+    ck_assert_int_eq(tk_store_cancel(s, ids[2], &err), TK_OK);
+    ck_assert_int_eq(tk_store_cancel(s, ids[5], &err), TK_OK);
+    json_t *docs = NULL;
+    size_t total = 0;
+    ck_assert_int_eq(tk_store_list(s, -1, 1, 3, &docs, &total, &err), TK_OK);
     ck_assert_uint_eq(total, 7);
-    ck_assert_uint_eq(n, 3);
-    ck_assert(jobs[0].id == ids[6] && jobs[1].id == ids[5] && jobs[2].id == ids[4]);
-    free(jobs);
-    ck_assert_int_eq(tk_store_list(s, true, TK_JOB_DONE, 1, 10, &jobs, &n, &total, &err), TK_OK);
-    ck_assert_uint_eq(total, 3);
-    ck_assert_uint_eq(n, 2);
-    ck_assert(jobs[0].id == ids[2] && jobs[1].id == ids[0]);
-    free(jobs);
-    int64_t *open = NULL;
-    ck_assert_int_eq(tk_store_unfinished(s, &open, &n, &err), TK_OK);
-    ck_assert_uint_eq(n, 3);
-    ck_assert(open[0] == ids[1] && open[1] == ids[3] && open[2] == ids[6]);
-    free(open);
+    ck_assert_uint_eq(json_array_size(docs), 3);
+    for (size_t i = 0; i < 3; i++)
+        ck_assert_int_eq(tk_job_id(json_array_get(docs, i)), ids[5 - i]);
+    json_decref(docs);
+    ck_assert_int_eq(tk_store_list(s, TK_JOB_CANCELLED, 0, 10, &docs, &total, &err), TK_OK);
+    ck_assert_uint_eq(total, 2);
+    ck_assert_int_eq(tk_job_id(json_array_get(docs, 0)), ids[5]);
+    ck_assert_int_eq(tk_job_id(json_array_get(docs, 1)), ids[2]);
+    json_decref(docs);
     size_t counts[TK_JOB_STATES];
-    ck_assert_int_eq(tk_store_count_states(s, counts, &err), TK_OK);
-    ck_assert_uint_eq(counts[TK_JOB_DONE], 3);
-    ck_assert_uint_eq(counts[TK_JOB_QUEUED], 2);
-    ck_assert_uint_eq(counts[TK_JOB_RUNNING], 1);
-    ck_assert_uint_eq(counts[TK_JOB_FAILED], 1);
-    ck_assert_uint_eq(counts[TK_JOB_CANCELLED], 0);
+    ck_assert_int_eq(tk_store_counts(s, counts, &err), TK_OK);
+    ck_assert(counts[TK_JOB_QUEUED] == 5 && counts[TK_JOB_CANCELLED] == 2 && counts[TK_JOB_DONE] == 0);
     tk_store_close(&s);
 }
 END_TEST
 
-START_TEST(state_names_round_trip)
+/* Claims from four threads at once: every claim a different job, oldest
+ * first within a thread. */
+enum { CLAIMERS = 4, CLAIMED = 60 };
+typedef struct claimer {
+    tk_store *s;
+    int64_t got[CLAIMED];
+    size_t n;
+} claimer;
+
+static void *claim_all(void *arg)
 {
-    for (int i = 0; i < TK_JOB_STATES; i++) {
-        tk_job_state back;
-        ck_assert(tk_job_state_parse(tk_job_state_name((tk_job_state)i), &back));
-        ck_assert_int_eq(back, i);
+    claimer *c = arg;
+    tk_error err;
+    int64_t id;
+    while (tk_store_claim(c->s, &id, &err) == TK_OK)
+        c->got[c->n++] = id;
+    return NULL;
+}
+
+START_TEST(claims_take_each_queued_job_once_oldest_first)
+{
+    tk_store *s = open_store();
+    for (int i = 0; i < CLAIMED; i++)
+        add_job(s, "k");
+    claimer c[CLAIMERS];
+    pthread_t t[CLAIMERS];
+    for (int i = 0; i < CLAIMERS; i++) {
+        c[i] = (claimer){.s = s};
+        pthread_create(&t[i], NULL, claim_all, &c[i]);
     }
-    tk_job_state x;
-    ck_assert(!tk_job_state_parse("finished", &x));
-    ck_assert(tk_job_state_final(TK_JOB_CANCELLED) && !tk_job_state_final(TK_JOB_RUNNING));
+    int seen[CLAIMED + 1] = {0};
+    size_t all = 0;
+    for (int i = 0; i < CLAIMERS; i++) {
+        pthread_join(t[i], NULL);
+        for (size_t k = 0; k < c[i].n; k++) {
+            ck_assert(c[i].got[k] >= 1 && c[i].got[k] <= CLAIMED);
+            seen[c[i].got[k]]++;
+            ck_assert(k == 0 || c[i].got[k] > c[i].got[k - 1]);
+        }
+        all += c[i].n;
+    }
+    ck_assert_uint_eq(all, CLAIMED);
+    for (int id = 1; id <= CLAIMED; id++)
+        ck_assert_int_eq(seen[id], 1);
+    ck_assert_str_eq(state_of(s, 7), "running");
+    /* a running job is neither cancelled nor deleted by the store; queued
+     * again (a restart) it is claimed again */
+    tk_error err;
+    int64_t id;
+    ck_assert_int_eq(tk_store_claim(s, &id, &err), TK_ENOTFOUND);
+    ck_assert_int_eq(tk_store_cancel(s, 7, &err), TK_EINVAL);
+    ck_assert_int_eq(tk_store_delete(s, 7, &err), TK_EINVAL);
+    ck_assert_int_eq(tk_store_requeue(s, &err), TK_OK);
+    ck_assert_int_eq(tk_store_claim(s, &id, &err), TK_OK);
+    ck_assert_int_eq(id, 1);
+    tk_store_close(&s);
+}
+END_TEST
+
+START_TEST(the_queue_limit_holds_and_ends_are_final)
+{
+    tk_store *s = open_store();
+    tk_job_options o = TK_JOB_OPTIONS_INIT;
+    tk_error err;
+    for (int i = 0; i < 4; i++) {
+        json_t *doc = tk_job_new("k", &o, 1, 3);
+        ck_assert_int_eq(tk_store_add(s, doc, input, 3, &err), i < 3 ? TK_OK : TK_EBUSY);
+        json_decref(doc);
+    }
+    ck_assert(strstr(err.message, "queue is full"));
+    ck_assert_int_eq(tk_store_cancel(s, 2, &err), TK_OK);
+    json_t *doc = get(s, 2);
+    ck_assert_str_eq(json_string_value(json_object_get(doc, "state")), "cancelled");
+    ck_assert_str_eq(json_string_value(json_object_get(doc, "stop_reason")), "cancelled");
+    ck_assert(json_is_string(json_object_get(doc, "finished")));
+    json_decref(doc);
+    ck_assert_int_eq(tk_store_cancel(s, 2, &err), TK_EINVAL);
+    ck_assert_int_eq(tk_store_delete(s, 1, &err), TK_EINVAL); /* queued */
+    ck_assert_int_eq(tk_store_delete(s, 2, &err), TK_OK);
+    ck_assert_int_eq(tk_store_get(s, 2, &doc, &err), TK_ENOTFOUND);
+    tk_store_close(&s);
+}
+END_TEST
+
+/* A write transaction left open on another connection: readers go on
+ * (WAL, a connection each); a writer would wait out the busy timeout. */
+START_TEST(readers_do_not_wait_for_a_writer)
+{
+    tk_store *s = open_store();
+    int64_t id = add_job(s, "k");
+    sqlite3 *db = NULL;
+    ck_assert_int_eq(sqlite3_open(path, &db), SQLITE_OK);
+    ck_assert_int_eq(sqlite3_exec(db, "BEGIN IMMEDIATE; UPDATE jobs SET curve = 'x';", NULL,
+                                  NULL, NULL), SQLITE_OK);
+    json_t *docs = NULL;
+    size_t total = 0;
+    tk_error err;
+    char *text = NULL;
+    ck_assert_int_eq(tk_store_list(s, -1, 0, 10, &docs, &total, &err), TK_OK);
+    ck_assert_uint_eq(total, 1);
+    ck_assert_int_eq(tk_store_part(s, id, TK_PART_CURVE, &text, NULL, &err), TK_OK);
+    ck_assert_ptr_null(text); /* not yet committed */
+    ck_assert_str_eq(state_of(s, id), "queued");
+    json_decref(docs);
+    sqlite3_exec(db, "COMMIT", NULL, NULL, NULL);
+    sqlite3_close(db);
+    tk_store_close(&s);
 }
 END_TEST
 
@@ -228,23 +289,20 @@ START_TEST(an_unwritable_path_is_an_error)
 {
     tk_store *s = NULL;
     tk_error err;
-    ck_assert_int_eq(tk_store_open("/nonexistent-dir/x/jobs.db", &s, &err), TK_EIO);
+    ck_assert_int_eq(tk_store_open("/nonexistent/dir/jobs.db", &s, &err), TK_EIO);
     ck_assert_ptr_null(s);
-    ck_assert(strstr(err.message, "/nonexistent-dir/x/jobs.db"));
+    ck_assert(strstr(err.message, "/nonexistent/dir/jobs.db"));
 }
 END_TEST
 
-/* The tables as the first version of the store made them, with one
- * finished job and its frame: opened by this one, the job reads back,
- * has no type or resume point stored, and takes one; its frame has no
- * layout of its own (it has the job's curve's). */
-START_TEST(an_older_store_gets_the_invariants_column)
+/* A store of the first version (a column per field, before the type and
+ * resume columns) opens as documents with its jobs, parts and frames. */
+START_TEST(a_first_version_store_becomes_documents)
 {
     sqlite3 *db = NULL;
     ck_assert_int_eq(sqlite3_open(path, &db), SQLITE_OK);
     const char *old =
-        "CREATE TABLE jobs ("
-        " id INTEGER PRIMARY KEY AUTOINCREMENT,"
+        "CREATE TABLE jobs (id INTEGER PRIMARY KEY AUTOINCREMENT,"
         " name TEXT NOT NULL, state TEXT NOT NULL, options TEXT NOT NULL,"
         " created REAL NOT NULL, started REAL, finished REAL,"
         " has_figures INTEGER NOT NULL DEFAULT 0,"
@@ -254,10 +312,13 @@ START_TEST(an_older_store_gets_the_invariants_column)
         " components INTEGER, fraction REAL, stop_reason TEXT, error TEXT,"
         " frames INTEGER NOT NULL DEFAULT 0,"
         " input TEXT NOT NULL, curve TEXT, contacts TEXT, history TEXT);"
-        "INSERT INTO jobs (name, state, options, created, step, ropelength, input, curve)"
-        " VALUES ('old', 'done', '{\"steps\": 5}', 1.7e9, 5, 33.5, 'VECT in', 'VECT out');"
-        "CREATE TABLE frames ("
-        " job INTEGER NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,"
+        "INSERT INTO jobs (name, state, options, created, finished, step, ropelength, vertices,"
+        " components, stop_reason, frames, input, curve) VALUES ('old', 'done',"
+        " '{\"steps\": 5, \"radius\": 0.5}', 1700000000.25, 1700000002.5, 5, 33.5, 47, 1,"
+        " 'steps', 1, 'VECT in', 'VECT out');"
+        "INSERT INTO jobs (name, state, options, created, input) VALUES ('waiting', 'queued',"
+        " '{}', 1700000003, 'VECT 2');"
+        "CREATE TABLE frames (job INTEGER NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,"
         " seq INTEGER NOT NULL, step INTEGER NOT NULL, xyz BLOB NOT NULL,"
         " PRIMARY KEY (job, seq));"
         "INSERT INTO frames VALUES (1, 0, 0,"
@@ -266,54 +327,57 @@ START_TEST(an_older_store_gets_the_invariants_column)
     ck_assert_msg(sqlite3_exec(db, old, NULL, NULL, &message) == SQLITE_OK, "%s", message);
     sqlite3_close(db);
 
-    tk_store *s = open_store();
-    tk_job j;
-    tk_error err;
-    ck_assert_int_eq(tk_store_get(s, 1, &j, &err), TK_OK);
-    ck_assert_str_eq(j.name, "old");
-    ck_assert_int_eq(j.state, TK_JOB_DONE);
-    ck_assert_int_eq(j.latest.step, 5);
-    ck_assert(j.latest.ropelength == 33.5);
-    char *text = (char *)"not read";
-    ck_assert_int_eq(tk_store_text(s, 1, TK_TEXT_INVARIANTS, &text, NULL, &err), TK_OK);
-    ck_assert_ptr_null(text);
-    ck_assert_int_eq(tk_store_text(s, 1, TK_TEXT_RESUME, &text, NULL, &err), TK_OK);
-    ck_assert_ptr_null(text);
-    tk_store_frame *frames = NULL;
-    size_t n = 0;
-    ck_assert_int_eq(tk_store_frames(s, 1, 0, 10, &frames, &n, &err), TK_OK);
-    ck_assert_uint_eq(n, 1);
-    ck_assert_uint_eq(frames[0].count, 3);
-    ck_assert(frames[0].xyz[0] == 1.0 && frames[0].xyz[2] == 1.0);
-    ck_assert_ptr_null(frames[0].layout);
-    tk_store_frames_free(frames, n);
-    const char *texts[TK_TEXTS] = {NULL};
-    texts[TK_TEXT_INVARIANTS] = "{\"start\":null}";
-    ck_assert_int_eq(tk_store_save(s, &j, texts, NULL, 0, &err), TK_OK);
-    tk_store_close(&s);
-    /* opening it again adds nothing more */
-    s = open_store();
-    ck_assert_int_eq(tk_store_text(s, 1, TK_TEXT_INVARIANTS, &text, NULL, &err), TK_OK);
-    ck_assert_str_eq(text, "{\"start\":null}");
-    free(text);
-    ck_assert_int_eq(tk_store_text(s, 1, TK_TEXT_CURVE, &text, NULL, &err), TK_OK);
-    ck_assert_str_eq(text, "VECT out");
-    free(text);
-    tk_store_close(&s);
+    for (int twice = 0; twice < 2; twice++) {
+        tk_store *s = open_store();
+        json_t *doc = get(s, 1);
+        ck_assert_str_eq(json_string_value(json_object_get(doc, "name")), "old");
+        ck_assert_str_eq(json_string_value(json_object_get(doc, "state")), "done");
+        ck_assert_int_eq(tk_job_step(doc), 5);
+        ck_assert(json_number_value(json_object_get(doc, "ropelength")) == 33.5);
+        ck_assert_str_eq(json_string_value(json_object_get(doc, "created")),
+                         "2023-11-14T22:13:20.250Z");
+        ck_assert_str_eq(json_string_value(json_object_get(doc, "finished")),
+                         "2023-11-14T22:13:22.500Z");
+        ck_assert(json_is_null(json_object_get(doc, "started")));
+        tk_job_options o;
+        tk_error err;
+        ck_assert_int_eq(tk_job_options_of(doc, &o, &err), TK_OK);
+        ck_assert_int_eq(o.run.max_steps, 5);
+        json_decref(doc);
+        char *text = NULL;
+        ck_assert_int_eq(tk_store_part(s, 1, TK_PART_CURVE, &text, NULL, &err), TK_OK);
+        ck_assert_str_eq(text, "VECT out");
+        free(text);
+        ck_assert_int_eq(tk_store_part(s, 1, TK_PART_RESUME, &text, NULL, &err), TK_OK);
+        ck_assert_ptr_null(text);
+        tk_frame *f = NULL;
+        size_t n = 0;
+        ck_assert_int_eq(tk_store_frames(s, 1, 0, 10, &f, &n, &err), TK_OK);
+        ck_assert_uint_eq(n, 1);
+        ck_assert(f[0].count == 3 && f[0].xyz[0] == 1.0 && f[0].xyz[2] == 1.0);
+        tk_frames_free(f, n);
+        int64_t id;
+        ck_assert_int_eq(tk_store_claim(s, &id, &err), TK_OK);
+        ck_assert_int_eq(id, twice ? 3 : 2); /* the old queued job, then the new one */
+        ck_assert_int_eq(add_job(s, "new"), 3 + twice);
+        tk_store_close(&s);
+    }
 }
 END_TEST
 
 int main(void)
 {
     Suite *s = suite_create("store");
-    TCase *tc = tcase_create("store");
+    TCase *tc = tcase_create("sqlite");
     tcase_add_checked_fixture(tc, setup, teardown);
     tcase_add_test(tc, a_job_reads_back_after_reopening);
     tcase_add_test(tc, missing_jobs_are_not_found);
     tcase_add_test(tc, listing_is_newest_first_filtered_and_paged);
-    tcase_add_test(tc, state_names_round_trip);
+    tcase_add_test(tc, claims_take_each_queued_job_once_oldest_first);
+    tcase_add_test(tc, the_queue_limit_holds_and_ends_are_final);
+    tcase_add_test(tc, readers_do_not_wait_for_a_writer);
     tcase_add_test(tc, an_unwritable_path_is_an_error);
-    tcase_add_test(tc, an_older_store_gets_the_invariants_column);
+    tcase_add_test(tc, a_first_version_store_becomes_documents);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);
 }

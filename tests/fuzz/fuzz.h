@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "tk/jobspec.h"
+#include "job.h"
 
 #define CHECK(cond)                                                                      \
     do {                                                                                 \

@@ -1,4 +1,4 @@
-/* Fuzz target: the run options by name (server/jobspec.c), the way the
+/* Fuzz target: the run options by name (server/job.c), the way the
  * HTTP query, the command line and a JSON body give them.
  *
  * The first byte picks the form: even, the rest is "name=value" pairs
@@ -16,7 +16,7 @@
 
 #include "fuzz.h"
 #include "tk/generate.h"
-#include "tk/jobspec.h"
+#include "job.h"
 #include "tk/tighten.h"
 
 static int from_text(tk_job_options *o, const char *text, size_t len)
@@ -74,15 +74,15 @@ static void check_domains(const tk_job_options *o)
 
 static void check_round_trip(const tk_job_options *o)
 {
-    json_t *j = tk_job_options_to_json(o);
-    CHECK(j);
-    tk_job_options back = TK_JOB_OPTIONS_INIT;
-    back.run.autoscale = !o->run.autoscale; /* so that the flags must be read back */
-    back.run.coarse_to_fine = !o->run.coarse_to_fine;
+    /* through the job's document, as the store keeps it */
+    json_t *doc = tk_job_new("fuzz", o, 1, 3);
+    CHECK(doc);
+    tk_job_options back, complete = *o;
+    tk_job_options_complete(&complete);
     tk_error err;
-    CHECK(tk_job_options_from_json(&back, j, NULL, &err) == TK_OK);
-    CHECK(fuzz_options_equal(&back, o));
-    json_decref(j);
+    CHECK(tk_job_options_of(doc, &back, &err) == TK_OK);
+    CHECK(fuzz_options_equal(&back, &complete));
+    json_decref(doc);
 }
 
 /* A run on a 24-vertex trefoil with the options, for a few steps at most:
@@ -93,8 +93,9 @@ static void check_run(const tk_job_options *o)
         return; /* thousands of vertices: too slow for a fuzz input */
     tk_curve *c = NULL;
     CHECK(tk_generate_torus(2, 3, 24, &c, NULL) == TK_OK);
-    tk_options run = TK_OPTIONS_INIT;
-    tk_job_options_to_run(o, &run);
+    tk_job_options job = *o;
+    tk_job_options_complete(&job);
+    tk_options run = job.run;
     run.max_steps = 2;
     run.max_seconds = 1.0;
     tk_run *r = NULL;

@@ -103,7 +103,7 @@ describe('inputs once accepted or answered 500', () => {
         assert.equal((await d.get('/v1/jobs')).json.total, 0, 'nothing stored');
     });
 
-    test('a spike whose resampled spline crosses the polygon: 422 saying so; without resampling it runs', async () => {
+    test('a spike whose resampled spline crosses the polygon: the job fails saying so; without resampling it runs', async () => {
         // a 16-gon of radius 10 with vertex 14 pulled out to radius 28
         const rows = [];
         for (let k = 0; k < 16; k++) {
@@ -112,9 +112,9 @@ describe('inputs once accepted or answered 500', () => {
         }
         const spike = `VECT\n1 16 0\n-16\n0\n${rows.join('\n')}\n`;
         for (const q of ['resolution=1', 'resolution=2', 'resolution=5']) {
-            const r = await d.post(`/v1/jobs?steps=5&autoscale=true&${q}`, spike, { type: 'text/plain' });
-            assert.equal(r.status, 422, `${q}: ${r.text}`);
-            assert.match(r.json.detail, /\(nearly\) cross itself/, q);
+            const failed = await waitFinal(d, (await submit(d, spike, { query: `steps=5&autoscale=true&${q}` })).id);
+            assert.equal(failed.state, 'failed', `${q}: ${JSON.stringify(failed)}`);
+            assert.match(failed.error, /\(nearly\) cross itself/, q);
         }
         const job = await waitFinal(d, (await submit(d, spike, { query: 'steps=5&autoscale=true' })).id);
         assert.equal(job.state, 'done');

@@ -1,13 +1,15 @@
-/* Tests for a job's options by name (server/jobspec.c): every name from
- * text and from JSON, the domains, the default step limit, and the round
- * trip through JSON. */
+/* Tests for the job document (server/job.c): its options by name from
+ * text and from JSON, their domains, the default step limit, the round
+ * trip through the document, and the document's figures against the
+ * step report they come from. */
 #include <check.h>
 #include <stdbool.h>
 #include <math.h>
 #include <string.h>
 
 #include "support.h"
-#include "tk/jobspec.h"
+#include "job.h"
+#include "jsonmap.h"
 
 /* Whether two option sets agree in every field. */
 static bool same(const tk_job_options *a, const tk_job_options *b)
@@ -74,10 +76,13 @@ START_TEST(json_options_round_trip)
                            0, "seed", 7, "coarse", 0, "overstep", 2e-5, "re_resolve", 0.0);
     tk_error err;
     ck_assert_int_eq(tk_job_options_from_json(&o, in, NULL, &err), TK_OK);
-    json_t *out = tk_job_options_to_json(&o);
-    ck_assert(json_equal(in, out));
+    json_t *doc = tk_job_new("knot", &o, 1, 3);
+    ck_assert(json_equal(in, json_object_get(doc, "options")));
+    tk_job_options back;
+    ck_assert_int_eq(tk_job_options_of(doc, &back, &err), TK_OK);
+    ck_assert(same(&o, &back));
     json_decref(in);
-    json_decref(out);
+    json_decref(doc);
     /* a whole number written as a real is a whole number */
     json_t *real_steps = json_pack("{s:f}", "steps", 40.0);
     ck_assert_int_eq(tk_job_options_from_json(&o, real_steps, NULL, &err), TK_OK);
@@ -117,33 +122,77 @@ END_TEST
 START_TEST(no_stop_criterion_means_the_default_steps)
 {
     tk_job_options o = TK_JOB_OPTIONS_INIT;
-    tk_options run;
-    tk_job_options_to_run(&o, &run);
-    ck_assert_int_eq(run.max_steps, TK_DEFAULT_STEPS);
+    tk_job_options_complete(&o);
+    ck_assert_int_eq(o.run.max_steps, TK_DEFAULT_STEPS);
+    o = (tk_job_options)TK_JOB_OPTIONS_INIT;
     o.run.max_seconds = 3.0;
-    tk_job_options_to_run(&o, &run);
-    ck_assert_int_eq(run.max_steps, 0);
-    ck_assert(run.max_seconds == 3.0);
-    o.every = 7;
     o.run.radius = 2.0;
-    tk_job_options_to_run(&o, &run);
-    ck_assert_uint_eq(run.snapshot_every, 0); /* frames are the service's */
-    ck_assert(run.radius == 2.0);
+    tk_job_options_complete(&o);
+    ck_assert_int_eq(o.run.max_steps, 0);
+    ck_assert(o.run.max_seconds == 3.0 && o.run.radius == 2.0);
     /* the engine's own defaults stay for what a job does not set */
     tk_options defaults = TK_OPTIONS_INIT;
-    ck_assert(run.overstep_tolerance == defaults.overstep_tolerance);
+    ck_assert(o.run.overstep_tolerance == defaults.overstep_tolerance);
+    /* a new job shows the budget it runs with */
+    tk_job_options none = TK_JOB_OPTIONS_INIT;
+    json_t *doc = tk_job_new("knot", &none, 1, 3);
+    ck_assert_int_eq(json_integer_value(json_object_get(json_object_get(doc, "options"), "steps")),
+                     TK_DEFAULT_STEPS);
+    json_decref(doc);
+}
+END_TEST
+
+/* The document's figures are the step report's, field by field; unknown
+ * until the run has measured; the progress is the spent share of the
+ * larger budget. */
+START_TEST(the_document_carries_the_step_figures)
+{
+    tk_job_options o = TK_JOB_OPTIONS_INIT;
+    o.run.max_steps = 200;
+    o.run.max_seconds = 10.0;
+    json_t *doc = tk_job_new("knot", &o, 2, 96);
+    ck_assert_str_eq(json_string_value(json_object_get(doc, "state")), "queued");
+    ck_assert_int_eq(json_integer_value(json_object_get(doc, "vertices")), 96);
+    ck_assert_int_eq(json_integer_value(json_object_get(doc, "components")), 2);
+    for (size_t i = 0; i < tk_step_nfields; i++) {
+        const json_t *v = json_object_get(doc, tk_step_fields[i].name);
+        ck_assert_msg(v != NULL, "%s missing", tk_step_fields[i].name);
+        if (tk_step_fields[i].kind == TK_KIND_REAL)
+            ck_assert_msg(json_is_null(v), "%s known before the run", tk_step_fields[i].name);
+    }
+    ck_assert(json_is_null(json_object_get(json_object_get(doc, "progress"), "fraction")));
+    tk_step_report r = {.step = 50, .seconds = 4.0, .ropelength = 33.5, .length = 16.75,
+                        .thickness = 1.0, .minrad = 0.7, .residual = 0.02, .struts = 12,
+                        .kinks = 3, .step_size = 1e-3, .rcond = 0.25, .violation = 1e-7,
+                        .corrections = 2, .vertices = 96, .escapes = 1};
+    tk_job_set_figures(doc, &r, &o);
+    for (size_t i = 0; i < tk_step_nfields; i++)
+        ck_assert_msg(json_number_value(json_object_get(doc, tk_step_fields[i].name)) ==
+                          tk_field_get(&tk_step_fields[i], &r),
+                      "%s", tk_step_fields[i].name);
+    const json_t *progress = json_object_get(doc, "progress");
+    ck_assert_int_eq(json_integer_value(json_object_get(progress, "step")), 50);
+    ck_assert_double_eq_tol(json_real_value(json_object_get(progress, "fraction")), 0.4, 1e-15);
+    ck_assert_int_eq(tk_job_step(doc), 50);
+    /* the start (step 0) has no step to measure */
+    r.step = 0;
+    tk_job_set_figures(doc, &r, &o);
+    ck_assert(json_is_null(json_object_get(doc, "residual")));
+    ck_assert(json_is_null(json_object_get(doc, "step_size")));
+    json_decref(doc);
 }
 END_TEST
 
 int main(void)
 {
-    Suite *s = suite_create("jobspec");
+    Suite *s = suite_create("job");
     TCase *tc = tcase_create("options");
     tcase_add_test(tc, every_option_is_set_from_text);
     tcase_add_test(tc, bad_values_name_the_option);
     tcase_add_test(tc, json_options_round_trip);
     tcase_add_test(tc, bad_json_points_at_the_option);
     tcase_add_test(tc, no_stop_criterion_means_the_default_steps);
+    tcase_add_test(tc, the_document_carries_the_step_figures);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);
 }

@@ -1,0 +1,62 @@
+/* tightknot service: the HTTP routes (openapi.yaml is their contract).
+ *
+ * libmicrohttpd answers on its own threads.  A request reads the store
+ * and the pool; POST checks what it can without the engine (the body, the
+ * VECT with its limits, the options' domains) and queues the job; the
+ * worker sets the run up, and a start it cannot tighten fails the job.
+ */
+#ifndef TK_SERVER_API_H
+#define TK_SERVER_API_H
+
+#include "pool.h"
+
+typedef struct tk_api_config {
+    const char *bind;       /* IPv4 address */
+    unsigned port;          /* 0: any free one (tk_api_port) */
+    size_t max_body;        /* larger bodies get 413 */
+    size_t max_body_total;  /* bodies held at once over all connections: 503 beyond */
+    size_t max_vertices;    /* larger VECT inputs get 422 */
+    size_t max_connections, max_per_address;
+    unsigned timeout;       /* seconds an idle connection is kept */
+    size_t threads;         /* threads answering requests */
+    const char *web;        /* the page's files, or NULL */
+    const char *catalogue;  /* a directory of *.vect offered by name, or NULL */
+} tk_api_config;
+
+typedef struct tk_api tk_api;
+
+int tk_api_start(const tk_api_config *cfg, tk_pool *pool, tk_store *store, tk_api **out,
+                 tk_error *err);
+unsigned tk_api_port(const tk_api *a);
+size_t tk_api_catalogue_size(const tk_api *a);
+void tk_api_refuse(tk_api *a); /* from now on every request gets 503 */
+void tk_api_stop(tk_api **p);
+
+/* A POST /v1/jobs as decoded, without HTTP and without the engine: the
+ * name, the options, and either the VECT text (not yet parsed, so that
+ * its errors name their line; it points into the body or into `json`) or
+ * a catalogue entry's name. */
+typedef struct tk_query_pair {
+    const char *key, *value; /* value NULL: no '=' */
+} tk_query_pair;
+
+typedef struct tk_submission {
+    const char *name, *vect, *catalogue;
+    size_t len;
+    tk_job_options options;
+    json_t *json; /* the body when it was JSON */
+} tk_submission;
+
+/* Why a submission is refused: 400 (not JSON), 415 (media type) or 422,
+ * the detail, and the member naming the culprit ("field", "option",
+ * "parameter"; "" when none) with its value. */
+typedef struct tk_problem {
+    unsigned status;
+    char detail[512], member[16], value[64];
+} tk_problem;
+
+int tk_submission_decode(const char *content_type, const tk_query_pair *query, size_t nquery,
+                         const char *body, size_t len, tk_submission *out, tk_problem *p);
+void tk_submission_clear(tk_submission *s);
+
+#endif

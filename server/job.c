@@ -1,0 +1,130 @@
+/* tightknot service: the job document (see job.h). */
+#include "job.h"
+
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+#include "jsonmap.h"
+
+const char *const tk_job_states[TK_JOB_STATES] = {"queued", "running", "done", "failed",
+                                                  "cancelled"};
+
+int tk_job_state_of(const char *name)
+{
+    for (int s = 0; name && s < TK_JOB_STATES; s++)
+        if (!strcmp(name, tk_job_states[s]))
+            return s;
+    return -1;
+}
+
+#define JOB_ROW(fld, kind, dflt, lo, hi, nm, hlp)                                        \
+    TK_FIELD_ROW(tk_job_options, run.fld, fld, kind, dflt, lo, hi, nm, hlp),
+
+const tk_field tk_job_option_fields[] = {
+    TK_OPTION_FIELDS(JOB_ROW)
+    {"every", "every", TK_KIND_LONG, offsetof(tk_job_options, every), 0, 0, 1e8,
+     "keep a frame every this many steps (0: none)"},
+};
+const size_t tk_job_option_nfields = sizeof tk_job_option_fields / sizeof tk_job_option_fields[0];
+
+int tk_job_option_set_text(tk_job_options *o, const char *name, const char *text, tk_error *err)
+{
+    const tk_field *f = tk_field_find(tk_job_option_fields, tk_job_option_nfields, name);
+    if (!f)
+        return tk_error_set(err, TK_EINVAL, "unknown option '%.60s'", name);
+    return tk_field_parse(f, o, text, err);
+}
+
+int tk_job_options_from_json(tk_job_options *o, const json_t *obj, const char **bad,
+                             tk_error *err)
+{
+    if (bad)
+        *bad = NULL;
+    if (!json_is_object(obj))
+        return tk_error_set(err, TK_EINVAL, "'options' must be a JSON object");
+    return tk_json_record_set(tk_job_option_fields, tk_job_option_nfields, o, obj, bad, err);
+}
+
+int tk_job_options_of(const json_t *doc, tk_job_options *o, tk_error *err)
+{
+    *o = (tk_job_options)TK_JOB_OPTIONS_INIT;
+    tk_error why;
+    if (tk_job_options_from_json(o, json_object_get(doc, "options"), NULL, &why))
+        return tk_error_set(err, TK_EIO, "the stored options of job %lld do not read back: %s",
+                            (long long)tk_job_id(doc), why.message);
+    return TK_OK;
+}
+
+void tk_job_options_complete(tk_job_options *o)
+{
+    if (!tk_options_have_stop(&o->run))
+        o->run.max_steps = TK_DEFAULT_STEPS;
+}
+
+json_t *tk_job_new(const char *name, const tk_job_options *o, size_t components,
+                   size_t vertices)
+{
+    tk_job_options run = *o;
+    tk_job_options_complete(&run);
+    json_t *doc = json_pack("{s:o, s:s, s:o, s:{s:i, s:n}, s:I, s:i, s:n, s:n, s:n, s:n, s:n}",
+                            "name", tk_json_text(name), "state", "queued", "options",
+                            tk_json_record(tk_job_option_fields, tk_job_option_nfields, &run),
+                            "progress", "step", 0, "fraction", "components",
+                            (json_int_t)components, "frames", 0, "stop_reason", "error",
+                            "invariants", "started", "finished");
+    /* figures: measurements unknown until the run has measured */
+    for (size_t i = 0; doc && i < tk_step_nfields; i++)
+        json_object_set_new(doc, tk_step_fields[i].name,
+                            tk_step_fields[i].kind == TK_KIND_REAL ? json_null() : json_integer(0));
+    json_object_set_new(doc, "vertices", json_integer((json_int_t)vertices));
+    tk_job_stamp(doc, "created");
+    return doc;
+}
+
+void tk_job_set_figures(json_t *doc, const tk_step_report *r, const tk_job_options *o)
+{
+    json_t *figures = tk_json_step(r);
+    json_object_update(doc, figures);
+    json_decref(figures);
+    if (r->step == 0) { /* the start has no step to measure */
+        json_object_set_new(doc, "residual", json_null());
+        json_object_set_new(doc, "step_size", json_null());
+    }
+    double f = -1.0;
+    if (o->run.max_steps > 0)
+        f = (double)r->step / (double)o->run.max_steps;
+    if (o->run.max_seconds > 0.0)
+        f = fmax(f, r->seconds / o->run.max_seconds);
+    json_object_set_new(doc, "progress",
+                        json_pack("{s:I, s:o}", "step", (json_int_t)r->step, "fraction",
+                                  f < 0.0 ? json_null() : json_real(fmin(f, 1.0))));
+}
+
+void tk_job_stamp(json_t *doc, const char *key)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    struct tm tm;
+    gmtime_r(&ts.tv_sec, &tm);
+    char buf[96];
+    snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03ldZ", tm.tm_year + 1900,
+             tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, ts.tv_nsec / 1000000);
+    json_object_set_new(doc, key, json_string(buf));
+}
+
+tk_job_state tk_job_state_in(const json_t *doc)
+{
+    int s = tk_job_state_of(json_string_value(json_object_get(doc, "state")));
+    return s < 0 ? TK_JOB_FAILED : (tk_job_state)s;
+}
+
+long tk_job_step(const json_t *doc)
+{
+    return (long)json_integer_value(json_object_get(json_object_get(doc, "progress"), "step"));
+}
+
+json_int_t tk_job_id(const json_t *doc)
+{
+    return json_integer_value(json_object_get(doc, "id"));
+}

@@ -1,0 +1,68 @@
+/* tightknot service: a job is one JSON document.
+ *
+ * The document is what GET /v1/jobs/{id} serves (openapi.yaml, Job) less
+ * its links: what was asked (name, options), where the job stands (state,
+ * progress, timestamps, stop reason, error, frames, knot type) and its
+ * latest figures, which are the fields of the engine's step report under
+ * their table's names (tk/tighten.h).  The store keeps it as it is, the
+ * pool updates it, the routes serve it: no field is listed twice.
+ */
+#ifndef TK_SERVER_JOB_H
+#define TK_SERVER_JOB_H
+
+#include <jansson.h>
+
+#include "tk/record.h"
+
+typedef enum tk_job_state {
+    TK_JOB_QUEUED, TK_JOB_RUNNING, TK_JOB_DONE, TK_JOB_FAILED, TK_JOB_CANCELLED, TK_JOB_STATES
+} tk_job_state;
+#define TK_JOB_FINAL(s) ((s) >= TK_JOB_DONE)
+extern const char *const tk_job_states[TK_JOB_STATES];
+
+/* The state called name, or -1. */
+int tk_job_state_of(const char *name);
+
+/* A job's options: the engine's run options (their table, by the names
+ * the command line uses) and the service's own `every` (a frame every
+ * this many steps). */
+typedef struct tk_job_options {
+    tk_options run;
+    long every;
+} tk_job_options;
+#define TK_JOB_OPTIONS_INIT {TK_OPTIONS_INIT, 0}
+extern const tk_field tk_job_option_fields[];
+extern const size_t tk_job_option_nfields;
+
+/* Sets the option `name` from text ("5", "1e-3", "true"): TK_EINVAL with
+ * a message naming it when it is unknown, malformed or out of domain. */
+int tk_job_option_set_text(tk_job_options *o, const char *name, const char *text, tk_error *err);
+
+/* Sets the options present in a JSON object; on failure *bad (when not
+ * NULL) is the offending name (valid while obj lives) or NULL. */
+int tk_job_options_from_json(tk_job_options *o, const json_t *obj, const char **bad,
+                             tk_error *err);
+
+/* The options of a stored document; TK_EIO when they do not read back. */
+int tk_job_options_of(const json_t *doc, tk_job_options *o, tk_error *err);
+
+/* The options a job runs with: the default step budget when no stop
+ * criterion is set, as the command line does. */
+void tk_job_options_complete(tk_job_options *o);
+
+/* A queued job's document, figures unknown (null), options complete. */
+json_t *tk_job_new(const char *name, const tk_job_options *o, size_t components,
+                   size_t vertices);
+
+/* Sets the figures of step r and the progress through the budget of o. */
+void tk_job_set_figures(json_t *doc, const tk_step_report *r, const tk_job_options *o);
+
+/* Sets doc[key] to the time now (ISO 8601, UTC, milliseconds). */
+void tk_job_stamp(json_t *doc, const char *key);
+
+/* The job's state, step and id as the document says. */
+tk_job_state tk_job_state_in(const json_t *doc);
+long tk_job_step(const json_t *doc);
+json_int_t tk_job_id(const json_t *doc);
+
+#endif
