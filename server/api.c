@@ -76,7 +76,7 @@ static result send_buffer(tk_api *a, conn *c, unsigned status, const char *type,
 static result send_json(tk_api *a, conn *c, unsigned status, json_t *o, const char *type,
                         const char *const *headers)
 {
-    char *text = o ? tk_json_dump(o, true) : NULL;
+    char *text = o ? tk_json_dump(o, false) : NULL;
     json_decref(o);
     if (!text)
         return send_buffer(a, c, 500, "text/plain", strdup("out of memory"), 13, NULL);
@@ -837,14 +837,15 @@ int tk_submission_decode(const char *content_type, const tk_query_pair *query, s
                            .len = len};
     int rc = TK_OK;
     tk_error err;
-    if (media_is(content_type, "application/json")) {
+    bool json = media_is(content_type, "application/json");
+    if (json) {
         rc = decode_json(body ? body : "", len, out, p);
     } else if (!media_is(content_type, "text/plain")) {
         rc = refuse(p, 415, NULL, NULL, "send application/json ({\"vect\": ...} or "
                     "{\"catalogue\": ...}) or text/plain (a VECT file, options in the query); "
                     "got %.80s", content_type ? content_type : "no Content-Type");
     }
-    for (size_t i = 0; !rc && !out->json && i < nquery; i++) {
+    for (size_t i = 0; !rc && !json && i < nquery; i++) { /* a text body's name and options */
         const char *key = query[i].key, *value = query[i].value ? query[i].value : "";
         json_t *name = strcmp(key, "name") ? NULL : json_string(value);
         if (name) { /* kept with the submission */
