@@ -1,8 +1,11 @@
 #!/bin/sh
 # bench/service.sh: how the service answers while every worker is busy.
 #
-# Starts tightknotd on a free loopback port with a fresh store, submits one
-# long catalogue job per worker, and then alternates windows of WINDOW
+# Starts tightknotd on a free loopback port with a fresh store, times the
+# submission of a 200,000-vertex VECT (POST does bounded work: the text,
+# its limits, the options), submits one long catalogue job per worker (a
+# frame every step, so the workers write frames at every save), and then
+# alternates windows of WINDOW
 # seconds: engine alone, engine while wrk polls GET /v1/jobs/{id}, engine
 # alone, ...  wrk runs twice per connection count: flat out (each
 # connection asks again as soon as it has its answer: saturation) and
@@ -53,11 +56,18 @@ long=$((12 * window + 60))
 ids=""
 for _ in $(seq "$workers"); do
     id=$(curl -sf -X POST -H 'Content-Type: application/json' \
-        -d "{\"catalogue\": \"$knot\", \"options\": {\"resolution\": 5, \"time\": $long}}" \
-        "$url/v1/jobs" | sed 's/^{"id":\([0-9]*\),.*/\1/')
+        -d "{\"catalogue\": \"$knot\", \"options\": {\"resolution\": 5, \"time\": $long, \"every\": 1}}" \
+        "$url/v1/jobs" | sed -n 's/.*"id":\([0-9]*\).*/\1/p')
     ids="$ids $id"
 done
 first=$(echo "$ids" | awk '{print $1}')
+# a large submission, timed by curl; cancelled before a worker is free for it
+"$build/tightknot" generate torus 2 3 --vertices 200000 >"$dir/large.vect"
+large=$(curl -sf -o "$dir/large.json" -w '%{time_total} %{http_code} %{size_upload}' -X POST \
+    -H 'Content-Type: text/plain' --data-binary @"$dir/large.vect" "$url/v1/jobs?steps=1")
+large_id=$(sed -n 's/.*"id":\([0-9]*\).*/\1/p' "$dir/large.json")
+curl -sf -X DELETE "$url/v1/jobs/$large_id" >/dev/null || true
+echo "$large" | awk '{printf "POST /v1/jobs with 200000 vertices (%.1f MB): %s in %.3f s\n", $3 / 1e6, $2, $1}'
 sleep 2
 steps() { curl -sf "$url/metrics" | awk '/^tightknot_steps_total/ {print $2}'; }
 # CPU ticks of the worker threads (named tk-worker) and of the daemon's

@@ -269,10 +269,12 @@ static result post_job(tk_api *a, conn *c, const request *rq)
     if (sub.catalogue && a->entries && find_entry(a, sub.catalogue))
         sub.vect = text = read_file(a->cfg.catalogue, sub.catalogue, ".vect", &sub.len);
     if (sub.catalogue && !sub.vect) {
+        result ret = problem(a, c, 422, json_pack("{s:s}", "field", "catalogue"), NULL, "%s%.80s%s",
+                             a->cfg.catalogue ? "the catalogue has no knot '" : "this server has "
+                             "no catalogue (start it with --catalogue)",
+                             a->cfg.catalogue ? sub.catalogue : "", a->cfg.catalogue ? "'" : "");
         tk_submission_clear(&sub);
-        return problem(a, c, 422, json_pack("{s:s}", "field", "catalogue"), NULL,
-                       a->entries ? "the catalogue has no knot of that name"
-                                  : "this server has no catalogue (start it with --catalogue)");
+        return ret;
     }
     tk_vect_limits limits = TK_VECT_LIMITS_INIT;
     limits.max_vertices = a->cfg.max_vertices;
@@ -833,8 +835,8 @@ int tk_submission_decode(const char *content_type, const tk_query_pair *query, s
                          const char *body, size_t len, tk_submission *out, tk_problem *p)
 {
     memset(p, 0, sizeof *p);
-    *out = (tk_submission){.name = "untitled", .options = TK_JOB_OPTIONS_INIT, .vect = body,
-                           .len = len};
+    *out = (tk_submission){.name = "untitled", .options = TK_JOB_OPTIONS_INIT,
+                           .vect = body ? body : "", .len = body ? len : 0};
     int rc = TK_OK;
     tk_error err;
     bool json = media_is(content_type, "application/json");

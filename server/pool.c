@@ -226,9 +226,11 @@ static int flush(job_run *jr, const json_t *end, tk_error *err)
         if (!rc && (!parts[TK_PART_CONTACTS] || !parts[TK_PART_HISTORY] || !parts[TK_PART_RESUME]))
             rc = tk_error_set(err, TK_ENOMEM, "out of memory writing a job");
     }
+    json_t *type = jr->run || jr->refused.ncomp || jr->input_type.ncomp ? invariants_json(jr)
+                                                                         : NULL;
     pthread_mutex_lock(&jr->pool->lock);
-    if (jr->run || jr->refused.ncomp || jr->input_type.ncomp)
-        json_object_set_new(jr->slot->doc, "invariants", invariants_json(jr));
+    if (type)
+        json_object_set_new(jr->slot->doc, "invariants", type);
     json_t *doc = json_deep_copy(jr->slot->doc);
     pthread_mutex_unlock(&jr->pool->lock);
     json_object_update(doc, (json_t *)end);

@@ -23,8 +23,10 @@ struct tk_store {
     char damage[TK_ERROR_MESSAGE_SIZE];      /* the first damage a reader found */
 };
 
+/* the parts' columns, in tk_part's order */
 static const char *const part_columns[TK_PARTS] = {"input", "curve", "contacts", "history",
                                                    "resume"};
+_Static_assert(TK_PARTS == 5, "tk_store_put writes the parts in one statement: name them there");
 
 static const char schema[] =
     "CREATE TABLE IF NOT EXISTS jobs (id INTEGER PRIMARY KEY AUTOINCREMENT,"
@@ -219,13 +221,14 @@ int tk_store_put(tk_store *s, const json_t *doc, const char *const *parts,
     int64_t id = tk_job_id(doc);
     char *text = tk_json_dump(doc, false);
     bool ok = text && sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK;
-    ok = ok && done(prepare(db, "UPDATE jobs SET state = ?, doc = ? WHERE id = ?", "tti",
-                            tk_job_states[tk_job_state_in(doc)], text, id));
-    for (int k = 0; ok && parts && k < TK_PARTS; k++) {
-        char sql[64];
-        snprintf(sql, sizeof sql, "UPDATE jobs SET %s = ? WHERE id = ?", part_columns[k]);
-        ok = !parts[k] || done(prepare(db, sql, "ti", parts[k], id));
-    }
+    const char *const *p = parts ? parts : (const char *const[TK_PARTS]){NULL};
+    ok = ok && done(prepare(db,
+                            "UPDATE jobs SET state = ?, doc = ?, input = coalesce(?, input),"
+                            " curve = coalesce(?, curve), contacts = coalesce(?, contacts),"
+                            " history = coalesce(?, history), resume = coalesce(?, resume)"
+                            " WHERE id = ?",
+                            "ttttttti", tk_job_states[tk_job_state_in(doc)], text, p[0], p[1],
+                            p[2], p[3], p[4], id));
     ok = ok && done(prepare(db, "DELETE FROM frames WHERE job = ? AND seq >= ?", "ii", id,
                             (int64_t)first));
     for (size_t i = 0; ok && i < nframes; i++)

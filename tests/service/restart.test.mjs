@@ -190,3 +190,56 @@ describe('frames across a restart', () => {
         }
     });
 });
+
+describe('SIGTERM while 100 clients poll', () => {
+    // The stop order (refuse requests, store the running jobs, stop the
+    // listener, then free the pool and close the store) under load: the
+    // sanitizer builds run this too, and the daemon's exit status carries
+    // what they find.
+    test('exits 0 within 10 s; every answer was whole; the jobs resume', async (t) => {
+        const d1 = await startDaemon({ workers: 2 });
+        t.after(() => d1.proc.kill('SIGKILL'));
+        const jobs = [];
+        for (const knot of ['3.1', '4.1'])
+            jobs.push(await submit(d1, { catalogue: knot, options: { resolution: 10, time: 60, every: 5 } }));
+        for (const job of jobs)
+            await waitJob(d1, job.id, (j) => j.state === 'running' && j.progress.step > 0);
+        const paths = [`/v1/jobs/${jobs[0].id}`, `/v1/jobs/${jobs[1].id}/frames?limit=2`, '/v1/jobs',
+            `/v1/jobs/${jobs[0].id}/struts`, `/v1/jobs/${jobs[1].id}/history`, '/v1/health'];
+        let polling = true;
+        const seen = {};
+        const pollers = Array.from({ length: 100 }, async (_, i) => {
+            const path = paths[i % paths.length];
+            while (polling) {
+                let r;
+                try {
+                    r = await d1.get(path, { timeout: 10000 });
+                } catch (e) {
+                    if (e.code === 'ERR_ASSERTION') throw e;
+                    await sleep(5); // refused: the daemon has stopped listening
+                    continue;
+                }
+                seen[r.status] = (seen[r.status] ?? 0) + 1;
+                assert.ok(r.status === 200 || r.status === 503, `${path}: ${r.status} ${r.text.slice(0, 200)}`);
+            }
+        });
+        await sleep(1500);
+        const seconds = await d1.stop();
+        polling = false;
+        await Promise.all(pollers);
+        t.diagnostic(`SIGTERM to exit under 100 pollers: ${seconds.toFixed(2)} s; answers ${JSON.stringify(seen)}`);
+        assert.ok((seen[200] ?? 0) >= 100, `answers: ${JSON.stringify(seen)}`);
+
+        const d2 = await startDaemon({ workers: 2, dir: d1.dir, db: d1.db });
+        try {
+            for (const job of jobs) {
+                const stored = (await d2.get(`/v1/jobs/${job.id}`)).json;
+                assert.ok(stored.progress.step > 0, `job ${job.id} stored at step ${stored.progress.step}`);
+                const running = await waitJob(d2, job.id, (j) => j.state === 'running' && j.progress.step > stored.progress.step);
+                assert.equal(running.finished, null);
+            }
+        } finally {
+            await d2.stop();
+        }
+    });
+});
