@@ -29,7 +29,7 @@ command -v wrk >/dev/null || { echo "bench/service: wrk is not installed (make d
 dir=$(mktemp -d)
 : >"$dir/log"
 "$build/tightknotd" --port 0 --db "$dir/bench.db" --catalogue "$catalogue" \
-    --worker-priority "$priority" >"$dir/log" 2>&1 &
+    --worker-priority "$priority" --max-per-address 1000 >"$dir/log" 2>&1 &
 pid=$!
 # the traps are set once the daemon runs, so that it never sees them
 stop_daemon() {
