@@ -95,9 +95,11 @@ int main(int argc, char **argv)
                    "                       (default: only CPU nothing else wants), low\n"
                    "                       (niceness 5) or normal (a machine shared with\n"
                    "                       other busy programs, which idle could starve)\n");
-            for (int i = 0; i < NSET; i++)
-                printf("  --%s %-*s%s\n", settings[i].name,
-                       (int)(18 - strlen(settings[i].name)), settings[i].arg, settings[i].help);
+            for (int i = 0; i < NSET; i++) {
+                int pad = 18 - (int)(strlen(settings[i].name) + strlen(settings[i].arg));
+                printf("  --%s %s%*s%s\n", settings[i].name, settings[i].arg, pad > 0 ? pad : 1, "",
+                       settings[i].help);
+            }
             printf("  -h, --help           this text\n\n"
                    "On start it prints the URL it listens on.  SIGINT or SIGTERM stops it\n"
                    "within a few seconds; running jobs are stored and resume at the next\n"
