@@ -134,8 +134,6 @@ static result damaged(tk_api *a, conn *c, int64_t id, const char *what, const ch
 
 static result store_problem(tk_api *a, conn *c, int rc, const tk_error *err)
 {
-    if (rc == TK_EIO && strstr(err->message, "does not read back"))
-        tk_store_damage(a->store, err->message);
     return PROBLEM(a, c, rc == TK_ENOTFOUND ? 404 : 500, "%s", err->message);
 }
 
@@ -379,8 +377,7 @@ static result get_history(tk_api *a, conn *c, const json_t *doc)
     if (n > (size_t)limit) { /* at most `limit`, evenly thinned, the last kept */
         json_t *thin = json_array();
         for (size_t i = 0; i < (size_t)limit; i++)
-            json_array_append(thin, json_array_get(steps, (size_t)((double)i * (double)(n - 1) /
-                                                                   (double)(limit - 1) + 0.5)));
+            json_array_append(thin, json_array_get(steps, tk_job_thin(i, n, (size_t)limit)));
         json_decref(steps);
         steps = thin;
     }
@@ -467,8 +464,9 @@ static result get_frames(tk_api *a, conn *c, const json_t *doc)
         for (size_t k = 0; k < stored[i].count; k++)
             json_array_append_new(coords, tk_json_number(stored[i].xyz[k]));
         json_t *counts = stored[i].layout ? json_loads(stored[i].layout, 0, NULL) : NULL;
-        json_t *layout = json_array_size(counts) == curve->ncomp ? json_array() : json_copy(comps);
-        for (size_t k = 0; json_array_size(counts) == curve->ncomp && k < curve->ncomp; k++)
+        bool own = json_array_size(counts) == curve->ncomp; /* else stored before frames had it */
+        json_t *layout = own ? json_array() : json_copy(comps);
+        for (size_t k = 0; own && k < curve->ncomp; k++)
             json_array_append_new(layout, json_pack("{s:O, s:b}", "vertices",
                                                     json_array_get(counts, k), "closed",
                                                     curve->closed[k]));

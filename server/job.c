@@ -113,6 +113,11 @@ void tk_job_stamp(json_t *doc, const char *key)
     json_object_set_new(doc, key, json_string(buf));
 }
 
+size_t tk_job_thin(size_t i, size_t n, size_t keep)
+{
+    return keep < 2 ? n - 1 : (size_t)((double)i * (double)(n - 1) / (double)(keep - 1) + 0.5);
+}
+
 tk_job_state tk_job_state_in(const json_t *doc)
 {
     int s = tk_job_state_of(json_string_value(json_object_get(doc, "state")));

@@ -60,6 +60,10 @@ void tk_job_set_figures(json_t *doc, const tk_step_report *r, const tk_job_optio
 /* Sets doc[key] to the time now (ISO 8601, UTC, milliseconds). */
 void tk_job_stamp(json_t *doc, const char *key);
 
+/* The index of the i-th of `keep` entries taken evenly from n (keep >= 2
+ * takes the first and the last): how a history is thinned. */
+size_t tk_job_thin(size_t i, size_t n, size_t keep);
+
 /* The job's state, step and id as the document says. */
 tk_job_state tk_job_state_in(const json_t *doc);
 long tk_job_step(const json_t *doc);

@@ -22,7 +22,11 @@ typedef struct slot {
     int64_t id;   /* the job it runs; 0: none */
     bool cancel;  /* its client asked to cancel it */
     tk_run *run;  /* once set up */
-    json_t *doc;  /* the job's document as it stands */
+    json_t *doc;  /* the job's document, less the figures below */
+    const tk_job_options *opts;
+    tk_step_report latest; /* the latest step's figures (once measured) */
+    bool measured;
+    size_t frames;         /* frames taken, stored or not */
 } slot;
 
 struct tk_pool {
@@ -50,9 +54,7 @@ typedef struct job_run {
     tk_pool *pool;
     tk_job_options opts;
     tk_run *run;
-    tk_step_report *hist;    /* every stride-th step, at most cfg.history */
-    size_t nhist;
-    long stride;
+    json_t *before;          /* a resumed job's history before its resume */
     tk_frame *pending;       /* frames taken since the last write */
     size_t npending, cap;
     size_t stored;           /* frames in the store */
@@ -64,57 +66,38 @@ typedef struct job_run {
     tk_invariants refused;    /* that of a stored curve the engine refused */
 } job_run;
 
-/* ---- history, thinned to a bounded size ---- */
+/* ---- history ---- */
 
-static void history_add(job_run *jr, const tk_step_report *r)
-{
-    if (r->step % jr->stride != 0)
-        return;
-    if (jr->nhist > 0 && jr->hist[jr->nhist - 1].step == r->step) {
-        jr->hist[jr->nhist - 1] = *r; /* a step reported again: the best curve put back */
-        return;
-    }
-    if (jr->nhist == jr->pool->cfg.history) { /* every other entry: evenly spaced still */
-        size_t kept = 0;
-        for (size_t i = 0; i < jr->nhist; i += 2)
-            jr->hist[kept++] = jr->hist[i];
-        jr->nhist = kept;
-        jr->stride *= 2;
-        if (r->step % jr->stride != 0)
-            return;
-    }
-    jr->hist[jr->nhist++] = *r;
-}
-
-/* The history as stored, the latest step last. */
+/* The history as stored: the entries before a resume and the run's own
+ * (the engine keeps every step), evenly thinned to at most cfg.history,
+ * the first and the latest kept. */
 static char *history_text(const job_run *jr)
 {
-    const tk_step_report *latest = tk_run_latest(jr->run);
+    size_t n = 0, before = json_array_size(jr->before);
+    const tk_step_report *h = tk_run_history(jr->run, &n);
+    size_t total = before + n, keep = total < jr->pool->cfg.history ? total : jr->pool->cfg.history;
     json_t *a = json_array();
-    for (size_t i = 0; i < jr->nhist; i++)
-        json_array_append_new(a, tk_json_step(&jr->hist[i]));
-    if (!jr->nhist || jr->hist[jr->nhist - 1].step < latest->step)
-        json_array_append_new(a, tk_json_step(latest));
+    for (size_t i = 0; i < keep; i++) {
+        size_t at = tk_job_thin(i, total, keep);
+        json_array_append_new(a, at < before ? json_incref(json_array_get(jr->before, at))
+                                             : tk_json_step(&h[at - before]));
+    }
     char *text = tk_json_dump(a, false);
     json_decref(a);
     return text;
 }
 
-/* A resumed job's history: the entries before its resume step (the
+/* A resumed job's stored history, the entries before its resume step (the
  * stored text ends with that step, which the run reports again). */
-static void history_load(job_run *jr, const char *text, long resume)
+static json_t *history_before(const char *text, long resume)
 {
-    json_t *a = text ? json_loads(text, 0, NULL) : NULL;
-    for (size_t i = 0; i < json_array_size(a) && jr->nhist < jr->pool->cfg.history; i++) {
-        tk_step_report r = {0};
-        if (!tk_json_record_set(tk_step_fields, tk_step_nfields, &r, json_array_get(a, i), NULL,
-                                NULL) && r.step < resume)
-            jr->hist[jr->nhist++] = r;
-    }
-    if (jr->nhist >= 2)
-        jr->stride = jr->hist[jr->nhist - 1].step - jr->hist[jr->nhist - 2].step;
-    jr->stride = jr->stride < 1 ? 1 : jr->stride;
-    json_decref(a);
+    json_t *stored = text ? json_loads(text, 0, NULL) : NULL, *entry, *before = json_array();
+    size_t i;
+    json_array_foreach(stored, i, entry)
+        if (json_integer_value(json_object_get(entry, "step")) < resume)
+            json_array_append(before, entry);
+    json_decref(stored);
+    return before;
 }
 
 /* ---- frames ---- */
@@ -171,6 +154,18 @@ static void take_frame(job_run *jr, long step, bool again)
 }
 
 /* ---- storing ---- */
+
+/* The slot's job as it stands: its document with the latest figures
+ * (made here, not at every step).  Lock held. */
+static json_t *current(const slot *sl)
+{
+    json_t *doc = json_deep_copy(sl->doc);
+    if (sl->measured) {
+        tk_job_set_figures(doc, &sl->latest, sl->opts);
+        json_object_set_new(doc, "frames", json_integer((json_int_t)sl->frames));
+    }
+    return doc;
+}
 
 /* {"start", "result"}: the input's type and the run's at its last check. */
 static json_t *invariants_json(const job_run *jr)
@@ -231,7 +226,7 @@ static int flush(job_run *jr, const json_t *end, tk_error *err)
     pthread_mutex_lock(&jr->pool->lock);
     if (type)
         json_object_set_new(jr->slot->doc, "invariants", type);
-    json_t *doc = json_deep_copy(jr->slot->doc);
+    json_t *doc = current(jr->slot);
     pthread_mutex_unlock(&jr->pool->lock);
     json_object_update(doc, (json_t *)end);
     if (!rc)
@@ -287,19 +282,21 @@ static int on_step(const tk_step_report *r, void *user)
     tk_pool *p = jr->pool;
     bool again = r->step == jr->last_step;
     jr->last_step = r->step;
-    history_add(jr, r);
     take_frame(jr, r->step, again);
     if (r->step > 0 && !again)
         atomic_fetch_add(&p->steps_total, 1);
     pthread_mutex_lock(&p->lock);
-    tk_job_set_figures(jr->slot->doc, r, &jr->opts);
-    json_object_set_new(jr->slot->doc, "frames", json_integer((json_int_t)(jr->stored + jr->npending)));
+    jr->slot->latest = *r;
+    jr->slot->measured = true;
+    jr->slot->frames = jr->stored + jr->npending;
+    bool go = p->stopping || jr->slot->cancel;
     pthread_mutex_unlock(&p->lock);
-    if (seconds_now() - jr->last_flush >= p->cfg.flush_seconds) {
+    if (!go && seconds_now() - jr->last_flush >= p->cfg.flush_seconds) {
         store_job(jr, NULL);
         jr->last_flush = seconds_now();
+        go = letting_go(jr, false); /* a paused store may have waited through either */
     }
-    return letting_go(jr, false);
+    return go;
 }
 
 /* ---- setting a run up ---- */
@@ -384,7 +381,7 @@ static int setup(job_run *jr, const json_t *doc, tk_error *err)
         char *hist = NULL;
         if (!rc && !tk_store_part(jr->pool->store, jr->slot->id, TK_PART_HISTORY, &hist, NULL,
                                   NULL))
-            history_load(jr, hist, step);
+            jr->before = history_before(hist, step);
         free(hist);
         jr->stored = (size_t)json_integer_value(json_object_get(doc, "frames"));
         jr->frame_after = step;
@@ -402,15 +399,11 @@ static void run_job(slot *sl, int64_t id)
     json_t *doc = NULL;
     if (tk_store_get(p->store, id, &doc, &err))
         return; /* unreadable: it stays as stored, and health says why */
-    job_run jr = {.slot = sl, .pool = p, .stride = 1, .frame_after = -1, .last_step = -1};
-    jr.hist = malloc(p->cfg.history * sizeof *jr.hist);
+    job_run jr = {.slot = sl, .pool = p, .frame_after = -1, .last_step = -1};
     pthread_mutex_lock(&p->lock);
-    sl->id = id;
-    sl->doc = doc;
-    sl->cancel = false;
+    *sl = (slot){.pool = p, .thread = sl->thread, .id = id, .doc = doc, .opts = &jr.opts};
     pthread_mutex_unlock(&p->lock);
-    int rc = jr.hist ? tk_job_options_of(doc, &jr.opts, &err)
-                     : tk_error_set(&err, TK_ENOMEM, "out of memory");
+    int rc = tk_job_options_of(doc, &jr.opts, &err);
     if (!rc)
         rc = setup(&jr, doc, &err);
     tk_stop_reason why = TK_STOP_NONE;
@@ -458,7 +451,7 @@ static void run_job(slot *sl, int64_t id)
     while (jr.npending)
         drop_frame(&jr);
     free(jr.pending);
-    free(jr.hist);
+    json_decref(jr.before);
 }
 
 /* ---- the workers ---- */
@@ -516,7 +509,7 @@ int tk_pool_start(tk_store *store, const tk_pool_config *cfg, tk_pool **out, tk_
     }
     p->store = store;
     p->cfg = *cfg;
-    p->cfg.history = cfg->history > 2 ? cfg->history : 2;
+    p->cfg.history = cfg->history > 2 ? cfg->history : 2; /* the first and the latest */
     pthread_mutex_init(&p->lock, NULL);
     pthread_cond_init(&p->wake, NULL);
     int rc = tk_store_requeue(store, err);
@@ -591,7 +584,7 @@ json_t *tk_pool_live(tk_pool *p, int64_t id)
 {
     pthread_mutex_lock(&p->lock);
     slot *sl = running(p, id);
-    json_t *doc = sl ? json_deep_copy(sl->doc) : NULL;
+    json_t *doc = sl ? current(sl) : NULL;
     pthread_mutex_unlock(&p->lock);
     return doc;
 }
@@ -611,7 +604,7 @@ int tk_pool_cancel(tk_pool *p, int64_t id, json_t **doc, tk_error *err)
             sl->cancel = true;
             if (sl->run)
                 tk_run_cancel(sl->run);
-            *doc = json_deep_copy(sl->doc);
+            *doc = current(sl);
         }
         pthread_mutex_unlock(&p->lock);
         if (sl)
@@ -641,10 +634,9 @@ void tk_pool_stats_get(tk_pool *p, tk_pool_stats *out)
         if (!p->slots[i].id)
             continue;
         out->running++;
-        double step = (double)tk_job_step(p->slots[i].doc);
-        double secs = json_number_value(json_object_get(p->slots[i].doc, "seconds"));
-        if (p->slots[i].run && step > 0 && secs > 0.0)
-            out->steps_per_second += step / secs;
+        const tk_step_report *r = &p->slots[i].latest;
+        if (p->slots[i].run && r->step > 0 && r->seconds > 0.0)
+            out->steps_per_second += (double)r->step / r->seconds;
     }
     pthread_mutex_unlock(&p->lock);
     out->steps_total = atomic_load(&p->steps_total);

@@ -266,9 +266,10 @@ static int one_text(tk_store *s, sqlite3_stmt *st, sqlite3 *db, char **text, siz
     return rc;
 }
 
-/* The document of a row (doc, id, state), or NULL when it does not read
- * back: the id and state are the columns'. */
-static json_t *row_doc(sqlite3_stmt *st)
+/* The document of a row (doc, id, state): the id and state are the
+ * columns'.  NULL (TK_EIO in err, and the store reported damaged) when
+ * it does not read back: SQLite checks its pages, not a row's bytes. */
+static json_t *row_doc(tk_store *s, sqlite3_stmt *st, tk_error *err)
 {
     json_t *doc = json_loads((const char *)sqlite3_column_text(st, 0), 0, NULL);
     if (json_is_object(doc)) {
@@ -277,6 +278,9 @@ static json_t *row_doc(sqlite3_stmt *st)
         return doc;
     }
     json_decref(doc);
+    tk_error_set(err, TK_EIO, "the stored document of job %lld does not read back",
+                 (long long)sqlite3_column_int64(st, 1));
+    tk_store_damage(s, err->message);
     return NULL;
 }
 
@@ -290,10 +294,8 @@ int tk_store_get(tk_store *s, int64_t id, json_t **doc, tk_error *err)
     int step = st ? sqlite3_step(st) : SQLITE_ERROR;
     int rc = step == SQLITE_DONE  ? tk_error_set(err, TK_ENOTFOUND, "there is no job %lld", (long long)id)
              : step != SQLITE_ROW ? failed(db, err, "reading a job")
-             : !(*doc = row_doc(st))
-                 ? tk_error_set(err, TK_EIO, "the stored document of job %lld does not read back",
-                                (long long)id)
-                 : TK_OK;
+             : !(*doc = row_doc(s, st, err)) ? TK_EIO
+                                              : TK_OK;
     sqlite3_finalize(st);
     give(s, db);
     return rc;
@@ -330,11 +332,10 @@ int tk_store_list(tk_store *s, int state, size_t offset, size_t limit, json_t **
             : NULL;
     int step = SQLITE_ERROR;
     json_t *doc = NULL;
-    while (st && (step = sqlite3_step(st)) == SQLITE_ROW && (doc = row_doc(st)) != NULL)
+    while (st && (step = sqlite3_step(st)) == SQLITE_ROW && (doc = row_doc(s, st, err)) != NULL)
         json_array_append_new(*docs, doc);
     int rc = step == SQLITE_DONE ? TK_OK
-             : step == SQLITE_ROW ? tk_error_set(err, TK_EIO, "the stored document of job %lld "
-                                                 "does not read back", sqlite3_column_int64(st, 1))
+             : step == SQLITE_ROW ? TK_EIO
                                   : failed(db, err, "listing jobs");
     sqlite3_finalize(st);
     give(s, db);
