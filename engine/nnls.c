@@ -98,8 +98,8 @@ struct tk_nnls {
 typedef struct nnls_factor {
     cholmod_factor *L;
     double delta;         /* added to the (unit) diagonal, 0 if none */
-    double rcond;         /* estimate for the unregularised M; 0 if singular;
-                             left alone when only regularised ones were tried */
+    double rcond;         /* estimate for the first matrix factorised,
+                             M + delta_min I; 0 if singular */
     int factorisations;   /* cholmod_factorize_p calls made */
     bool singular;        /* too ill-conditioned, and not regularised */
 } nnls_factor;
@@ -423,7 +423,7 @@ static int factor_normal(tk_nnls *s, const cholmod_sparse *T, const int *order,
         if ((rc = factor_once(s, T, slot->L, delta, &est, err)) != TK_OK)
             return rc;
         f->factorisations++;
-        if (delta == 0.0)
+        if (delta == delta_min)
             f->rcond = est;
         if (est > 0.0 && est >= rcond_floor) {
             f->delta = delta;
@@ -463,19 +463,19 @@ static int factor_solve(tk_nnls *s, cholmod_factor *L, double *rhs, size_t n,
     return TK_OK;
 }
 
-/* z = (T T' + delta I)^{-1} c, with `refine` steps of refinement whose
- * residual c - T (T' z) - delta z comes from T itself.  With
- * `unregularised`, the residual leaves out delta z: the steps are then
- * iterated Tikhonov regularisation, which converge to the minimum-norm
- * solution of T T' z = c when c is in the range of T (each step shrinks
- * the error along an eigenvalue lambda by delta / (lambda + delta)), and
- * so take the bias of the regularisation out of T' z.  w (m entries) and
- * res (nrow entries) are workspace. */
+/* z = (T T' + delta I)^{-1} c, solved with the factor (of T T' +
+ * f->delta I) and `refine` steps of refinement whose residual
+ * c - T (T' z) - delta z comes from T itself.  With delta = 0 < f->delta
+ * the steps are iterated Tikhonov regularisation, which converge to the
+ * minimum-norm solution of T T' z = c when c is in the range of T (each
+ * step shrinks the error along an eigenvalue lambda by
+ * f->delta / (lambda + f->delta)), and so take the bias of the
+ * regularisation out of T' z.  w (m entries) and res (nrow entries) are
+ * workspace. */
 static int normal_solve(tk_nnls *s, const cholmod_sparse *T, const nnls_factor *f,
                         const double *c, double *z, double *w, double *res, int refine,
-                        bool unregularised, tk_error *err)
+                        double delta, tk_error *err)
 {
-    double delta = unregularised ? 0.0 : f->delta;
     size_t nf = T->nrow;
     const double *sol;
     memcpy(res, c, nf * sizeof *res);
@@ -566,6 +566,8 @@ typedef struct nnls_work {
     double tolb;          /* tolerance times ||b|| */
     double rcond_floor;
     int max_iter;
+    double mu;            /* the proximal weight (0: the plain problem) */
+    double *centre;       /* n: the proximal centre c (when mu > 0) */
     double *colnorm;      /* s_i = ||a_i|| */
     double *inv_norm;     /* 1 / s_i, 0 for zero columns */
     double *y;            /* A^T (A x - b) */
@@ -605,6 +607,7 @@ static void work_free(nnls_work *w)
     free(w->next);
     free(w->passive);
     free(w->blocked);
+    free(w->centre);
 }
 
 /* One fill-reducing order (AMD on A^T A) of all the columns.  A solve
@@ -684,8 +687,9 @@ static int passive_solve(nnls_work *w, bool may_regularise, bool *singular, doub
         if (w->passive[w->order[j]])
             w->suborder[k++] = w->place[w->order[j]];
     nnls_factor f = {NULL, 0.0, 1.0, 0, false};
-    int rc = factor_normal(w->s, w->T, w->suborder, may_regularise ? w->delta_mode : 0.0,
-                           may_regularise, w->rcond_floor, &f, err);
+    double delta_min = w->mu > 0.0 ? w->mu : may_regularise ? w->delta_mode : 0.0;
+    int rc = factor_normal(w->s, w->T, w->suborder, delta_min, may_regularise || w->mu > 0.0,
+                           w->rcond_floor, &f, err);
     w->rep.factorisations += f.factorisations;
     w->rep.rcond = fmin(w->rep.rcond, f.rcond);
     if (rc != TK_OK)
@@ -694,19 +698,23 @@ static int passive_solve(nnls_work *w, bool may_regularise, bool *singular, doub
         *singular = true;
         return TK_OK;
     }
-    if (f.delta > 0.0) {
+    if (f.delta > w->mu) {
         w->delta_mode = f.delta;
         w->rep.regularised = true;
         w->rep.regularisation = fmax(w->rep.regularisation, f.delta);
     }
     t_times(w->T, w->b, w->c);
+    /* The proximal problem's normal equations are
+     * (T T' + mu I) z = T b + mu z_c, z_c the centre scaled. */
+    for (size_t q = 0; q < nf && w->mu > 0.0; q++)
+        w->c[q] += w->mu * w->colnorm[w->F[q]] * w->centre[w->F[q]];
     /* When regularised, c = T b is in the range of T, so iterated Tikhonov
      * steps recover the least-squares solution (of minimum norm, up to
      * rounding along the null space, which does not change A x): the
      * residual is then that of the unregularised problem, not one
      * inflated by delta. */
     rc = normal_solve(w->s, w->T, &f, w->c, w->zq, w->r, w->res,
-                      f.delta > 0.0 ? NNLS_TIKHONOV_STEPS : 1, true, err);
+                      f.delta > w->mu ? NNLS_TIKHONOV_STEPS : 1, w->mu, err);
     if (rc != TK_OK)
         return rc;
     memset(out, 0, w->n * sizeof *out);
@@ -715,8 +723,9 @@ static int passive_solve(nnls_work *w, bool may_regularise, bool *singular, doub
     return TK_OK;
 }
 
-/* r = A x - b and y = A^T r (for every column, or only the active ones
- * with y = 0 on the passive set, as block pivoting defines it). */
+/* r = A x - b and y = A^T r + mu D^2 (x - c), the objective's half
+ * gradient (for every column, or only the active ones with y = 0 on the
+ * passive set, as block pivoting defines it). */
 static void gradient(nnls_work *w, const double *x, bool active_only)
 {
     const int *Ai = w->A->i;
@@ -731,8 +740,15 @@ static void gradient(nnls_work *w, const double *x, bool active_only)
         for (size_t e = lo; e < hi; e++)
             w->r[Ai[e]] += Ax[e] * x[i];
     }
-    for (size_t i = 0; i < w->n; i++)
-        w->y[i] = active_only && w->passive[i] ? 0.0 : col_dot(w->A, i, w->r);
+    for (size_t i = 0; i < w->n; i++) {
+        if (active_only && w->passive[i]) {
+            w->y[i] = 0.0;
+            continue;
+        }
+        w->y[i] = col_dot(w->A, i, w->r);
+        if (w->mu > 0.0)
+            w->y[i] += w->mu * w->colnorm[i] * w->colnorm[i] * (x[i] - w->centre[i]);
+    }
 }
 
 /* Whether variable i is infeasible, in the scale-free sense above. */
@@ -940,7 +956,7 @@ int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *
     tk_nnls_options o = TK_NNLS_OPTIONS_INIT;
     nnls_work w;
     memset(&w, 0, sizeof w);
-    w.rep = (tk_nnls_report){0, 0, false, false, 0.0, 1.0, 0.0, 0};
+    w.rep = (tk_nnls_report){0, 0, false, false, 0.0, 1.0, 0.0, 0.0, 0};
     int rc = TK_OK;
 
     if (!s)
@@ -964,13 +980,23 @@ int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *
     w.rcond_floor = o.rcond_floor >= 0.0 ? o.rcond_floor : NNLS_DEFAULT_RCOND_FLOOR;
     double tol = o.kkt_tolerance > 0.0 ? o.kkt_tolerance : NNLS_DEFAULT_TOLERANCE;
 
+    if (!(o.proximal >= 0.0) || !isfinite(o.proximal))
+        return tk_error_set(err, TK_EINVAL, "nnls: the proximal weight %g is not >= 0",
+                            o.proximal);
+    w.mu = o.proximal;
     bool *guess = NULL;
-    if (o.warm_start && n > 0) {
+    if ((o.warm_start || w.mu > 0.0) && n > 0) {
         guess = malloc(n * sizeof *guess);
-        if (!guess)
+        w.centre = calloc(n, sizeof *w.centre);
+        if (!guess || !w.centre) {
+            free(guess);
+            free(w.centre);
             return tk_error_set(err, TK_ENOMEM, "out of memory for nnls (%zu columns)", n);
-        for (size_t i = 0; i < n; i++)
+        }
+        for (size_t i = 0; i < n; i++) {
             guess[i] = x[i] > 0.0;
+            w.centre[i] = w.mu > 0.0 && x[i] > 0.0 ? x[i] : 0.0;
+        }
     }
     for (size_t i = 0; i < n; i++)
         x[i] = 0.0;
@@ -1012,8 +1038,12 @@ int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *
             x[i] = 0.0;
     gradient(&w, x, true);
     w.rep.residual = norm2(w.r, m);
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < n; i++) {
         w.rep.passive += x[i] > 0.0;
+        if (w.mu > 0.0)
+            w.rep.proximal_term +=
+                w.mu * w.colnorm[i] * w.colnorm[i] * x[i] * (x[i] - w.centre[i]);
+    }
 
 done:
     if (report)
@@ -1088,7 +1118,7 @@ int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, doubl
      * different targets), so the refinement stays on the regularised
      * system: iterated Tikhonov would blow its null-space part up by
      * 1 / delta a step */
-    if ((rc = normal_solve(s, T, &f, c, z, du, res, f.delta > 0.0 ? 2 : 1, false, err)) !=
+    if ((rc = normal_solve(s, T, &f, c, z, du, res, f.delta > 0.0 ? 2 : 1, f.delta, err)) !=
         TK_OK)
         goto done;
     t_transpose_times(T, z, du);

@@ -950,6 +950,98 @@ START_TEST(two_threads_match_series)
 }
 END_TEST
 
+/* Asserts the KKT conditions of the proximal problem
+ *     min ||A x - b||^2 + mu sum_j s_j^2 (x_j - c_j)^2,  x >= 0
+ * at x (its half gradient A^T (A x - b) + mu s_j^2 (x_j - c_j) is >= 0,
+ * and 0 where x_j > 0), tolerance as assert_kkt's. */
+static void assert_proximal_kkt(const cholmod_sparse *A, const double *b, const double *c,
+                                double mu, const double *x, double rel, const char *what)
+{
+    size_t m = A->nrow, n = A->ncol;
+    double *res = malloc((m + 1) * sizeof *res), *g = malloc((n + 1) * sizeof *g);
+    ck_assert(res && g);
+    residual_gradient(A, b, x, res, g);
+    double bn = vnorm(b, m);
+    for (size_t j = 0; j < n; j++) {
+        double sj = column_norm(A, j), tol = rel * sj * bn;
+        g[j] += mu * sj * sj * (x[j] - c[j]);
+        ck_assert_msg(x[j] >= 0.0, "%s: x[%zu] = %g < 0", what, j, x[j]);
+        ck_assert_msg(g[j] >= -tol, "%s: gradient[%zu] = %g < -%g", what, j, g[j], tol);
+        if (x[j] > 0.0)
+            ck_assert_msg(fabs(g[j]) <= tol, "%s: x[%zu] = %g > 0 but gradient %g", what, j,
+                          x[j], g[j]);
+    }
+    free(res);
+    free(g);
+}
+
+/* The proximal problem on rank-deficient and wide problems, where the
+ * plain one needs regularisation and the fallback: its KKT conditions
+ * hold without regularisation, from a random centre; and the proximal point
+ * method (each answer the next centre) ends at the plain problem's
+ * residual, as found by the plain solver. */
+START_TEST(proximal_problems)
+{
+    tk_nnls *s = new_solver();
+    cholmod_common *cc = tk_nnls_common(s);
+    tkt_rng r = {4242};
+    int plain_fallback = 0;
+    for (int kind = 0; kind < 3; kind++)
+        for (int trial = 0; trial < 8; trial++) {
+            size_t V = 60, n0 = 90, extra = kind == 2 ? 360 : 40;
+            cholmod_sparse *A = rank_deficient(cc, &r, kind, V, n0, extra);
+            size_t m = A->nrow, n = A->ncol;
+            double *b = random_vector(&r, m);
+            double *c = malloc(n * sizeof *c), *x = malloc(n * sizeof *x);
+            double *plain = malloc(n * sizeof *plain);
+            for (size_t j = 0; j < n; j++) {
+                double v = tkt_rng_range(&r, -1, 1);
+                c[j] = v > 0.0 ? v : 0.0;
+            }
+            char what[80];
+            snprintf(what, sizeof what, "kind %d trial %d (%zu x %zu)", kind, trial, m, n);
+            tk_nnls_report rep;
+            ck_assert_int_eq(solve(s, A, b, plain, &tight, &rep), TK_OK);
+            plain_fallback += rep.used_fallback;
+            double best = rep.residual;
+            tk_nnls_options o = tight;
+            o.proximal = 1e-2;
+            memcpy(x, c, n * sizeof *x);
+            ck_assert_msg(solve(s, A, b, x, &o, &rep) == TK_OK, "%s: not converged", what);
+            ck_assert_msg(!rep.regularised, "%s: regularised", what);
+            assert_proximal_kkt(A, b, c, o.proximal, x, 1e-9, what);
+            ck_assert(rep.residual >= best * (1.0 - 1e-12));
+            /* the proximal point method: the residual falls to the plain
+             * problem's (within 1e-10 ||b||: it may be 0) */
+            double bn = vnorm(b, m), previous = rep.residual;
+            int it = 0;
+            for (; it < 2000 && rep.residual > best + 1e-10 * bn; it++) {
+                ck_assert_int_eq(solve(s, A, b, x, &o, &rep), TK_OK);
+                ck_assert_msg(rep.residual <= previous + 1e-12 * bn, "%s: rose from %.17g to %.17g",
+                              what, previous, rep.residual);
+                previous = rep.residual;
+            }
+            ck_assert_msg(rep.residual <= best + 1e-10 * bn, "%s: %.17g, plain %.17g", what,
+                          rep.residual, best);
+            free(b);
+            free(c);
+            free(x);
+            free(plain);
+            cholmod_free_sparse(&A, cc);
+        }
+    /* the same problems needed the fallback when plain */
+    ck_assert_int_gt(plain_fallback, 0);
+    tk_nnls_options bad = tight;
+    bad.proximal = -1.0;
+    double A1[3] = {1, 0, 0}, b1[3] = {1, 1, 1}, x1[1] = {0};
+    cholmod_sparse *A = sparse_from_dense(cc, 3, 1, A1);
+    tk_error err;
+    ck_assert_int_eq(tk_nnls_solve(s, A, b1, x1, &bad, NULL, &err), TK_EINVAL);
+    cholmod_free_sparse(&A, cc);
+    tk_nnls_free(&s);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("nnls");
@@ -966,6 +1058,7 @@ int main(void)
     tcase_add_test(tc, repeat_solves_are_identical);
     tcase_add_test(tc, min_norm_solutions);
     tcase_add_test(tc, two_threads_match_series);
+    tcase_add_test(tc, proximal_problems);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);
 }

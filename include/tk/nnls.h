@@ -46,9 +46,14 @@ typedef struct tk_nnls_options {
                                are the first passive set (in the flow, the
                                previous step's answer: pivoting then often
                                ends in one or two iterations) */
+    double proximal;        /* mu > 0: solve the proximal problem instead,
+                                   minimise ||A x - b||^2
+                                            + mu sum_i s_i^2 (x_i - c_i)^2,
+                               s_i = ||a_i||, c = max(x, 0) on entry; 0: the
+                               plain problem.  See below. */
 } tk_nnls_options;
 
-#define TK_NNLS_OPTIONS_INIT {0, 1e-10, 1e-14, false}
+#define TK_NNLS_OPTIONS_INIT {0, 1e-10, 1e-14, false, 0.0}
 
 typedef struct tk_nnls_report {
     int iterations;         /* pivoting iterations */
@@ -62,8 +67,13 @@ typedef struct tk_nnls_report {
                                (of A_F^T A_F with unit-norm columns: the
                                pivot ratio of its Cholesky factor, as
                                cholmod_rcond; 0 for a singular one; 1 when
-                               no column is passive) */
+                               no column is passive; of A_F^T A_F + mu I for
+                               the proximal problem) */
     double residual;        /* || A x - b || at the answer */
+    double proximal_term;   /* mu sum_i s_i^2 x_i (x_i - c_i) = -(A x) . (A x - b)
+                               at the proximal answer (0 at the plain one):
+                               how far it leaves the residual from orthogonal
+                               to A x */
     size_t passive;         /* number of x_i > 0 */
 } tk_nnls_report;
 
@@ -80,6 +90,20 @@ cholmod_common *tk_nnls_common(tk_nnls *s);
  * satisfying x >= 0 could be produced (x then holds the best found). */
 int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *x,
                   const tk_nnls_options *opts, tk_nnls_report *report, tk_error *err);
+
+/* The proximal problem (opts->proximal = mu > 0) is strictly convex: its
+ * answer is unique and moves continuously with A, b and the centre c, and
+ * block pivoting from c's support finishes without the fallback (its
+ * normal matrix M + mu I is positive definite, of condition at most about
+ * (1 + mu) / mu).  Repeated with the answer as the next centre it is the
+ * proximal point method, whose iterates converge to the plain problem's
+ * answer nearest the first centre: along an eigenvalue lambda of the scaled
+ * A^T A the distance shrinks by mu / (lambda + mu) a time, so A x is off
+ * by at most sqrt(mu) / 2 times |c - x*| (scaled) after one.  The flow
+ * solves one proximal problem a step, centred at the last step's forces:
+ * where constraints are many and dependent (thousands of struts on nearly
+ * parallel strands), the plain problem's answer is not unique and block
+ * pivoting stalls on it.  The report's residual is ||A x - b||. */
 
 /* The minimum-norm solution du (m entries) of the underdetermined system
  * A^T du = r (r has n entries), du = A y with (A^T A + delta D) y = r,
