@@ -150,7 +150,8 @@ const char *tk_stop_reason_name(tk_stop_reason r);
     X(struts, SIZE, 0, 0, 0, "struts", "active struts")                                     \
     X(kinks, SIZE, 0, 0, 0, "kinks", "active kinks")                                        \
     X(step_size, REAL, 0, 0, 0, "step_size", "h of the step taken")                         \
-    X(rcond, REAL, 0, 0, 0, "rcond", "NNLS condition estimate (1 without constraints)")    \
+    X(rcond, REAL, 0, 0, 0, "rcond",                                                        \
+      "condition estimate of the NNLS's proximal normal matrix (1 without constraints)")    \
     X(violation, REAL, 0, 0, 0, "violation",                                                \
       "worst constraint violation after the step / tau")                                     \
     X(corrections, INT, 0, 0, 0, "corrections", "Newton iterations after the step")         \
