@@ -1,0 +1,251 @@
+/* Starts that are not the catalogue's: for each knot or link type with a
+ * best known ropelength, several starts (the catalogue file, a disguised
+ * copy of it, parametric curves of the same type, disguised in turn) are
+ * tightened at the same resolution for the same wall time, and each run
+ * prints its final ropelength, its excess over the best known value, when
+ * it came within 0.5% and 0.1% of it on its final polygon, the escapes it
+ * tried and whether the type held.  Two starts of one type that end apart
+ * found different critical configurations: at most one is tight.
+ * Prints figures; never fails on time.
+ *
+ *   bench/starts [CATALOGUE_DIR] [--seconds S] [--resolution R] [--jobs N]
+ *                [--list] [START ...]
+ */
+#include <math.h>
+#include <pthread.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "tk/curve.h"
+#include "tk/generate.h"
+#include "tk/tighten.h"
+#include "tk/vect.h"
+
+/* Best known ropelengths (length / tube radius) of the public atlas of
+ * tight knots at its vertex counts, and exact values. */
+#define ROPE_3_1 32.743665
+#define ROPE_4_1 42.09703
+#define ROPE_5_1 47.21489
+#define ROPE_6_1 56.71771
+#define ROPE_8_19 60.99699
+#define ROPE_10_124 71.08937
+#define ROPE_HOPF 25.132741228718345 /* 8 pi */
+#define ROPE_CHAIN3 41.69911184307752 /* 12 pi + 4 */
+
+typedef enum maker { FILE_START, TORUS, FIGURE_EIGHT, HOPF, CHAIN } maker;
+
+/* A start: a catalogue file or a generator, then a disguise (seed 0: none). */
+typedef struct start {
+    const char *name;
+    const char *type;
+    double best;
+    maker make;
+    const char *file;   /* FILE_START: the catalogue's name */
+    int p, q;           /* TORUS */
+    size_t vertices;    /* generators: per component (0: default) */
+    unsigned long long seed;
+    double perturbation;
+} start;
+
+static const start starts[] = {
+    {"3.1", "3_1", ROPE_3_1, FILE_START, "3.1", 0, 0, 0, 0, 0},
+    {"3.1~", "3_1", ROPE_3_1, FILE_START, "3.1", 0, 0, 0, 11, 0.05},
+    {"T(2,3)", "3_1", ROPE_3_1, TORUS, NULL, 2, 3, 120, 0, 0},
+    {"T(2,3)~", "3_1", ROPE_3_1, TORUS, NULL, 2, 3, 120, 12, 0.01},
+    {"4.1", "4_1", ROPE_4_1, FILE_START, "4.1", 0, 0, 0, 0, 0},
+    {"4.1~", "4_1", ROPE_4_1, FILE_START, "4.1", 0, 0, 0, 13, 0.05},
+    {"fig8", "4_1", ROPE_4_1, FIGURE_EIGHT, NULL, 0, 0, 200, 0, 0},
+    {"fig8~", "4_1", ROPE_4_1, FIGURE_EIGHT, NULL, 0, 0, 200, 14, 0.01},
+    {"5.1", "5_1", ROPE_5_1, FILE_START, "5.1", 0, 0, 0, 0, 0},
+    {"T(2,5)", "5_1", ROPE_5_1, TORUS, NULL, 2, 5, 200, 0, 0},
+    {"T(2,5)~", "5_1", ROPE_5_1, TORUS, NULL, 2, 5, 200, 15, 0.01},
+    {"6.1", "6_1", ROPE_6_1, FILE_START, "6.1", 0, 0, 0, 0, 0},
+    {"6.1~", "6_1", ROPE_6_1, FILE_START, "6.1", 0, 0, 0, 16, 0.05},
+    {"8.19", "8_19", ROPE_8_19, FILE_START, "8.19", 0, 0, 0, 0, 0},
+    {"T(3,4)", "8_19", ROPE_8_19, TORUS, NULL, 3, 4, 240, 0, 0},
+    {"T(3,4)~", "8_19", ROPE_8_19, TORUS, NULL, 3, 4, 240, 17, 0.01},
+    {"10.124", "10_124", ROPE_10_124, FILE_START, "10.124", 0, 0, 0, 0, 0},
+    {"T(3,5)", "10_124", ROPE_10_124, TORUS, NULL, 3, 5, 300, 0, 0},
+    {"T(3,5)~", "10_124", ROPE_10_124, TORUS, NULL, 3, 5, 300, 18, 0.01},
+    {"T(2,7)", "7_1", NAN, TORUS, NULL, 2, 7, 280, 0, 0},
+    {"2.2.1", "Hopf", ROPE_HOPF, FILE_START, "2.2.1", 0, 0, 0, 0, 0},
+    {"hopf~", "Hopf", ROPE_HOPF, HOPF, NULL, 0, 0, 60, 19, 0.01},
+    {"chain3~", "chain3", ROPE_CHAIN3, CHAIN, NULL, 0, 0, 60, 20, 0.01},
+};
+#define NSTARTS (sizeof starts / sizeof starts[0])
+
+static tk_curve *make_start(const start *s, const char *dir, tk_error *err)
+{
+    tk_curve *c = NULL, *d = NULL;
+    int rc = TK_OK;
+    char path[4096];
+    switch (s->make) {
+    case FILE_START:
+        snprintf(path, sizeof path, "%s/%s.vect", dir, s->file);
+        rc = tk_vect_read_file(path, NULL, &c, err);
+        break;
+    case TORUS:
+        rc = tk_generate_torus(s->p, s->q, s->vertices, &c, err);
+        break;
+    case FIGURE_EIGHT:
+        rc = tk_generate_figure_eight(s->vertices, &c, err);
+        break;
+    case HOPF:
+        rc = tk_generate_hopf(s->vertices, &c, err);
+        break;
+    case CHAIN:
+        rc = tk_generate_chain(3, s->vertices, &c, err);
+        break;
+    }
+    if (rc != TK_OK || s->seed == 0)
+        return rc == TK_OK ? c : NULL;
+    rc = tk_generate_disguise(c, s->seed, s->perturbation, &d, err);
+    tk_curve_free(&c);
+    return rc == TK_OK ? d : NULL;
+}
+
+typedef struct bench {
+    const char *dir;
+    double seconds, resolution;
+    const start *todo[NSTARTS];
+    size_t ntodo, next;
+    pthread_mutex_t lock;
+} bench;
+
+static void describe(char *buf, size_t size, double t)
+{
+    if (t < 0.0)
+        snprintf(buf, size, "never");
+    else
+        snprintf(buf, size, "%.1fs", t);
+}
+
+static void run_start(bench *b, const start *s)
+{
+    tk_error err;
+    char line[512];
+    tk_curve *c = make_start(s, b->dir, &err);
+    if (!c) {
+        snprintf(line, sizeof line, "%-9s %-7s start failed: %s\n", s->name, s->type,
+                 err.message);
+        pthread_mutex_lock(&b->lock);
+        fputs(line, stdout);
+        fflush(stdout);
+        pthread_mutex_unlock(&b->lock);
+        return;
+    }
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = b->resolution;
+    o.max_seconds = b->seconds;
+    tk_run *run = NULL;
+    int rc = tk_run_new(c, &o, &run, &err);
+    tk_stop_reason why = TK_STOP_NONE;
+    if (rc == TK_OK)
+        rc = tk_run_until(run, &why, &err);
+    if (!run) {
+        snprintf(line, sizeof line, "%-9s %-7s refused: %s\n", s->name, s->type, err.message);
+    } else {
+        const tk_step_report *last = tk_run_latest(run);
+        size_t nh = 0, ne = 0;
+        const tk_step_report *h = tk_run_history(run, &nh);
+        const tk_escape *e = tk_run_escapes(run, &ne);
+        size_t improved = 0;
+        for (size_t k = 0; k < ne; k++)
+            improved += e[k].improved;
+        /* the crossings count on the final polygon, whose count the
+         * best known value's excess is about */
+        double within[2] = {-1.0, -1.0}, margin[2] = {0.005, 0.001};
+        for (size_t i = 0; i < nh && isfinite(s->best); i++)
+            for (int k = 0; k < 2; k++)
+                if (within[k] < 0.0 && h[i].vertices == last->vertices &&
+                    h[i].ropelength <= s->best * (1.0 + margin[k]))
+                    within[k] = h[i].seconds;
+        char excess[16] = "-", w5[16], w1[16];
+        if (isfinite(s->best))
+            snprintf(excess, sizeof excess, "%+.3f%%", 100.0 * (last->ropelength / s->best - 1.0));
+        describe(w5, sizeof w5, within[0]);
+        describe(w1, sizeof w1, within[1]);
+        snprintf(line, sizeof line, "%-9s %-7s %8zu %8ld %11.5f %10s %9s %9s %5zu %5zu  %s%s%s\n",
+                 s->name, s->type, last->vertices, last->step, last->ropelength, excess, w5, w1,
+                 ne, improved, tk_stop_reason_name(why), rc ? ": " : "", rc ? err.message : "");
+    }
+    pthread_mutex_lock(&b->lock);
+    fputs(line, stdout);
+    fflush(stdout);
+    pthread_mutex_unlock(&b->lock);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+
+static void *worker(void *arg)
+{
+    bench *b = arg;
+    for (;;) {
+        pthread_mutex_lock(&b->lock);
+        size_t k = b->next < b->ntodo ? b->next++ : SIZE_MAX;
+        pthread_mutex_unlock(&b->lock);
+        if (k == SIZE_MAX)
+            return NULL;
+        run_start(b, b->todo[k]);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    bench b = {.dir = "../shared/catalogue", .seconds = 120.0, .resolution = 5.0};
+    long jobs = 2;
+    pthread_mutex_init(&b.lock, NULL);
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            printf("usage: starts [CATALOGUE_DIR] [--seconds S] [--resolution R] [--jobs N]\n"
+                   "              [--list] [START ...]\n"
+                   "Tightens each start (default: all; --list names them) at resolution R\n"
+                   "(default 5) for S seconds (default 120), N at a time (default 2), and\n"
+                   "prints its final ropelength, its excess over the best known value and\n"
+                   "when it came within 0.5%% and 0.1%% of it on its final polygon.\n");
+            return 0;
+        } else if (strcmp(argv[i], "--list") == 0) {
+            for (size_t k = 0; k < NSTARTS; k++)
+                printf("%-9s %-7s %s\n", starts[k].name, starts[k].type,
+                       starts[k].make == FILE_START ? "catalogue" : "generated");
+            return 0;
+        } else if (strcmp(argv[i], "--seconds") == 0 && i + 1 < argc) {
+            b.seconds = strtod(argv[++i], NULL);
+        } else if (strcmp(argv[i], "--resolution") == 0 && i + 1 < argc) {
+            b.resolution = strtod(argv[++i], NULL);
+        } else if (strcmp(argv[i], "--jobs") == 0 && i + 1 < argc) {
+            jobs = strtol(argv[++i], NULL, 10);
+        } else if (strchr(argv[i], '/') || strcmp(argv[i], ".") == 0) {
+            b.dir = argv[i];
+        } else {
+            size_t k = 0;
+            while (k < NSTARTS && strcmp(starts[k].name, argv[i]) != 0)
+                k++;
+            if (k == NSTARTS) {
+                fprintf(stderr, "starts: no start '%s' (--list names them)\n", argv[i]);
+                return 2;
+            }
+            b.todo[b.ntodo++] = &starts[k];
+        }
+    }
+    if (b.ntodo == 0)
+        for (size_t k = 0; k < NSTARTS; k++)
+            b.todo[b.ntodo++] = &starts[k];
+    if (jobs < 1 || jobs > 64)
+        jobs = 1;
+    printf("starts at resolution %g, %.0f s each, %ld at a time; excess over the best known "
+           "value; within: first time on the final polygon\n\n",
+           b.resolution, b.seconds, jobs);
+    printf("%-9s %-7s %8s %8s %11s %10s %9s %9s %5s %5s  %s\n", "start", "type", "vertices",
+           "steps", "ropelength", "excess", "within.5%", "within.1%", "esc", "impr", "stop");
+    pthread_t th[64];
+    for (long k = 0; k < jobs; k++)
+        pthread_create(&th[k], NULL, worker, &b);
+    for (long k = 0; k < jobs; k++)
+        pthread_join(th[k], NULL);
+    pthread_mutex_destroy(&b.lock);
+    return 0;
+}
