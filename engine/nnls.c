@@ -1053,8 +1053,8 @@ done:
     return rc;
 }
 
-int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, double *du,
-                     double *delta_used, tk_error *err)
+int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, double delta_min,
+                     double *du, double *delta_used, tk_error *err)
 {
     int rc = TK_OK;
     int *F = NULL, *next = NULL;
@@ -1072,6 +1072,9 @@ int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, doubl
         return rc;
     if (m > 0 && !du)
         return tk_error_set(err, TK_EINVAL, "nnls: no du vector");
+    if (!(delta_min >= 0.0 && delta_min <= NNLS_DELTA_CAP))
+        return tk_error_set(err, TK_EINVAL, "nnls: damping %g outside [0, %g]", delta_min,
+                            NNLS_DELTA_CAP);
     for (size_t k = 0; k < m; k++)
         du[k] = 0.0;
     if (n == 0 || m == 0)
@@ -1112,7 +1115,8 @@ int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, doubl
     }
     build_transpose(A, F, nf, inv_norm, T, next);
     nnls_factor f = {NULL, 0.0, 1.0, 0, false};
-    if ((rc = factor_normal(s, T, NULL, 0.0, true, NNLS_DEFAULT_RCOND_FLOOR, &f, err)) != TK_OK)
+    if ((rc = factor_normal(s, T, NULL, delta_min, true, NNLS_DEFAULT_RCOND_FLOOR, &f, err)) !=
+        TK_OK)
         goto done;
     /* r need not be in the range of A^T (dependent constraints with
      * different targets), so the refinement stays on the regularised

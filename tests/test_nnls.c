@@ -690,7 +690,7 @@ START_TEST(degenerate_problems)
     ck_assert(rep.rcond == 1.0 && rep.iterations == 0);
     double du[6];
     double delta;
-    ck_assert_int_eq(tk_nnls_min_norm(s, A, NULL, du, &delta, &err), TK_OK);
+    ck_assert_int_eq(tk_nnls_min_norm(s, A, NULL, 0.0, du, &delta, &err), TK_OK);
     for (int k = 0; k < 6; k++)
         ck_assert(du[k] == 0.0);
     cholmod_free_sparse(&A, cc);
@@ -785,7 +785,7 @@ static void check_min_norm(tk_nnls *s, const cholmod_sparse *A, tkt_rng *r, bool
     double *g = malloc((n + 1) * sizeof *g);
     double delta = -1;
     tk_error err;
-    ck_assert_msg(tk_nnls_min_norm(s, A, rr, du, &delta, &err) == TK_OK, "%s: %s", what,
+    ck_assert_msg(tk_nnls_min_norm(s, A, rr, 0.0, du, &delta, &err) == TK_OK, "%s: %s", what,
                   err.message);
     ck_assert(delta == 0.0);
     /* A^T du = r */
@@ -876,12 +876,72 @@ START_TEST(min_norm_solutions)
     cholmod_sparse *A = sparse_from_dense(cc, 4, 3, D);
     double rr[3] = {1, 1, 2}, du[4], delta = 0;
     tk_error err;
-    ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, du, &delta, &err), TK_OK);
+    ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, 0.0, du, &delta, &err), TK_OK);
     ck_assert(delta > 0.0);
     /* consistent right-hand side: A^T du = r still holds closely */
     ck_assert_double_eq_tol(du[0] + du[2], 1.0, 1e-6);
     ck_assert_double_eq_tol(du[1], 0.0, 1e-12);
     ck_assert_double_eq_tol(du[0], du[2], 1e-6);
+    cholmod_free_sparse(&A, cc);
+    tk_nnls_free(&s);
+}
+END_TEST
+
+START_TEST(damped_min_norm_steps)
+{
+    /* More columns than rows (n > m: inconsistent, as recovery's violated
+     * struts outnumber the coordinates): with damping delta the answer
+     * satisfies the damped least-squares optimality condition
+     * A D^-1 (A^T du - r) + delta du = 0, D = diag(A^T A), checked here
+     * from A itself (to 1e-6: the damped system's condition is up to
+     * 1 / delta). */
+    tk_nnls *s = new_solver();
+    cholmod_common *cc = tk_nnls_common(s);
+    tkt_rng r = {29};
+    const double deltas[3] = {1e-8, 1e-6, 1e-3};
+    for (int trial = 0; trial < 30; trial++) {
+        size_t V = 3 + (size_t)(tkt_rng_next(&r) % 6), n = 3 * V + 1 + tkt_rng_next(&r) % 20;
+        size_t m = 3 * V;
+        cholmod_sparse *A = flow_matrix(cc, &r, V, n);
+        double *rr = random_vector(&r, n), *du = malloc(m * sizeof *du);
+        double *g = malloc(n * sizeof *g), *kkt = malloc(m * sizeof *kkt);
+        double delta = deltas[trial % 3], used = -1;
+        tk_error err;
+        ck_assert_msg(tk_nnls_min_norm(s, A, rr, delta, du, &used, &err) == TK_OK, "%s",
+                      err.message);
+        ck_assert(used >= delta);
+        const int *Ap = A->p, *Ai = A->i;
+        const double *Ax = A->x;
+        for (size_t i = 0; i < m; i++)
+            kkt[i] = used * du[i];
+        for (size_t j = 0; j < n; j++) {
+            double d = 0.0, gj = -rr[j];
+            for (int e = Ap[j]; e < Ap[j + 1]; e++) {
+                d += Ax[e] * Ax[e];
+                gj += Ax[e] * du[Ai[e]];
+            }
+            g[j] = gj;
+            for (int e = Ap[j]; e < Ap[j + 1]; e++)
+                kkt[Ai[e]] += Ax[e] * gj / d;
+        }
+        double scale = used * vnorm(du, m) + 1e-300;
+        ck_assert_msg(vnorm(kkt, m) <= 1e-6 * fmax(scale, vnorm(rr, n)),
+                      "trial %d (delta %g): optimality %g against %g", trial, used,
+                      vnorm(kkt, m), scale);
+        /* du = 0 leaves all of r: the step does better */
+        ck_assert(vnorm(g, n) < vnorm(rr, n));
+        free(rr);
+        free(du);
+        free(g);
+        free(kkt);
+        cholmod_free_sparse(&A, cc);
+    }
+    /* a negative or huge damping is refused */
+    cholmod_sparse *A = flow_matrix(cc, &r, 4, 4);
+    double rr[4] = {1, 2, 3, 4}, du[12];
+    tk_error err;
+    ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, -1e-6, du, NULL, &err), TK_EINVAL);
+    ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, 1.0, du, NULL, &err), TK_EINVAL);
     cholmod_free_sparse(&A, cc);
     tk_nnls_free(&s);
 }
@@ -911,7 +971,7 @@ static void *run_job(void *arg)
         double *b = random_vector(&r, 3 * jb->V), *rr = random_vector(&r, jb->n);
         jb->rc = tk_nnls_solve(s, A, b, jb->x + round * jb->n, NULL, NULL, &err);
         if (jb->rc == TK_OK)
-            jb->rc = tk_nnls_min_norm(s, A, rr, jb->du + round * 3 * jb->V, NULL, &err);
+            jb->rc = tk_nnls_min_norm(s, A, rr, 0.0, jb->du + round * 3 * jb->V, NULL, &err);
         free(b);
         free(rr);
         cholmod_free_sparse(&A, cc);
@@ -1057,6 +1117,7 @@ int main(void)
     tcase_add_test(tc, invalid_input_and_iteration_limit);
     tcase_add_test(tc, repeat_solves_are_identical);
     tcase_add_test(tc, min_norm_solutions);
+    tcase_add_test(tc, damped_min_norm_steps);
     tcase_add_test(tc, two_threads_match_series);
     tcase_add_test(tc, proximal_problems);
     suite_add_tcase(s, tc);

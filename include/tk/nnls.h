@@ -107,11 +107,16 @@ int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *
 
 /* The minimum-norm solution du (m entries) of the underdetermined system
  * A^T du = r (r has n entries), du = A y with (A^T A + delta D) y = r,
- * D = diag(A^T A), delta = 0 unless the factorisation needs it (then
- * *delta_used = delta > 0).  Zero columns of A are left out (their rows
- * of A^T du = r cannot hold unless r is 0 there).  delta_used may be NULL.
- * Used for error recovery (section 4.6). */
-int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, double *du,
-                     double *delta_used, tk_error *err);
+ * D = diag(A^T A), delta = delta_min unless the factorisation needs more
+ * (*delta_used gives it).  With delta > 0, du is the damped least-squares
+ * (Levenberg-Marquardt) step: it minimises
+ * |A^T du - r|^2_{D^-1} + delta |du|^2, so A D^-1 (A^T du - r) + delta du
+ * = 0.  Where A^T du = r is inconsistent or nearly so (more constraints
+ * than coordinates, many dependent), the minimum-norm answer is long and
+ * rounding-dominated and this one is not.  Zero columns of A are left out
+ * (their rows of A^T du = r cannot hold unless r is 0 there).  delta_used
+ * may be NULL.  Used for error recovery (section 4.6). */
+int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, double delta_min,
+                     double *du, double *delta_used, tk_error *err);
 
 #endif
