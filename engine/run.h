@@ -108,7 +108,10 @@ struct tk_run {
         double *rhs;     /* one per violated constraint */
         size_t rhs_capacity;
         double *du;      /* 3V: a Newton step */
+        double *before;  /* 3V: the curve before this step, to undo it */
         double seconds, nnls_seconds, check_seconds;
+        long rescales, undone;
+        double largest_rescale; /* scale factor - 1 */
     } recovery;
 
     struct {             /* schedule.c */
@@ -247,8 +250,18 @@ void tk_stepping_reset(tk_run *r);
  * when all hold); the finder must be fitted to c. */
 int tk_recovery_violation(tk_run *r, const tk_curve *c, double *out, tk_error *err);
 /* Corrects the run's curve until no constraint is violated beyond the
- * correction tolerance (section 4.6); the finder is then fitted to it. */
-int tk_recovery_correct(tk_run *r, int *iterations, tk_error *err);
+ * correction tolerance (section 4.6); the finder is then fitted to it.
+ * What the Newton steps leave is removed by rescaling the curve about its
+ * centroid when it is at most rescale_up_to (a fraction of the bound);
+ * otherwise the call fails with TK_ENUMERIC, the curve as the Newton steps
+ * left it. */
+int tk_recovery_correct(tk_run *r, double rescale_up_to, int *iterations, tk_error *err);
+/* Rescaling the whole curve throws away its contacts (and at a violation
+ * of a few percent, the work of minutes): after a step it only removes a
+ * leftover this small, a feasibility fix; a step that needs more is undone
+ * and taken again shorter.  A start may need more (its own slack). */
+#define TK_RESCALE_FEASIBILITY 1e-6
+#define TK_RESCALE_START(r) (10.0 * (r)->opt.overstep_tolerance)
 /* Scales the curve about its centroid to undo a violation `worst`. */
 void tk_recovery_rescale(tk_run *r, double worst);
 int tk_recovery_fit(tk_run *r, size_t vertices, tk_error *err);

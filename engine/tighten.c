@@ -10,6 +10,10 @@
 #include "tk/record.h"
 #include "tk/thickness.h"
 
+/* Tries at a step: the step, then up to STEP_ATTEMPTS - 1 shorter ones
+ * when error recovery cannot restore the thickness (see step). */
+#define STEP_ATTEMPTS 4
+
 double tk_clock(void)
 {
     struct timespec ts;
@@ -174,7 +178,7 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
     rep.rcond = 1.0;
     rep.residual = NAN;
     if (!rc)
-        rc = tk_recovery_correct(r, &rep.corrections, err);
+        rc = tk_recovery_correct(r, TK_RESCALE_START(r), &rep.corrections, err);
     if (!rc)
         rc = tk_active_find(r, r->shared.curve, &r->active.set, err);
     if (!rc)
@@ -355,16 +359,31 @@ static int step(tk_run *r, tk_error *err)
         return rc;
     }
     tk_curve *c = r->shared.curve;
-    tk_strut_finder_refit(r->shared.finder, c);
-    rc = tk_active_find(r, c, &r->active.set, err);
-    if (!rc)
-        rc = tk_stepping_step(r, &rep, err);
-    tk_schedule_watch(r);
-    double worst = 0.0;
-    if (!rc)
-        rc = tk_recovery_violation(r, c, &worst, err);
-    if (!rc && worst > 0.5 * tk_tolerance_overstep(r))
-        rc = tk_recovery_correct(r, &rep.corrections, err);
+    memcpy(r->recovery.before, c->xyz, 3 * c->nvert * sizeof *c->xyz);
+    for (int attempt = 0;; attempt++) {
+        tk_strut_finder_refit(r->shared.finder, c);
+        rc = tk_active_find(r, c, &r->active.set, err);
+        if (!rc)
+            rc = tk_stepping_step(r, &rep, err);
+        if (attempt == 0)
+            tk_schedule_watch(r);
+        double worst = 0.0;
+        if (!rc)
+            rc = tk_recovery_violation(r, c, &worst, err);
+        /* the last attempt may rescale as the start may */
+        double up_to = attempt < STEP_ATTEMPTS - 1 ? TK_RESCALE_FEASIBILITY : TK_RESCALE_START(r);
+        if (!rc && worst > 0.5 * tk_tolerance_overstep(r))
+            rc = tk_recovery_correct(r, up_to, &rep.corrections, err);
+        if (rc != TK_ENUMERIC || attempt == STEP_ATTEMPTS - 1 || !(rep.step_size > 0.0))
+            break;
+        /* Newton steps could not restore the thickness: undo the step,
+         * take one a quarter as long (section 4.5's control doubles the
+         * last step size first, so it starts at half) */
+        memcpy(c->xyz, r->recovery.before, 3 * c->nvert * sizeof *c->xyz);
+        r->stepping.step_size = 0.25 * rep.step_size;
+        r->recovery.undone++;
+        rep.corrections = 0;
+    }
     if (!rc)
         rc = figures(r, &rep, err);
     if (rc) {
@@ -444,6 +463,9 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out)
         .nnls_iterations = r->motion.nnls_iterations,
         .factorisations = r->motion.factorisations,
         .invariants = r->type.seconds + r->escape.type_seconds,
+        .undone_steps = r->recovery.undone,
+        .rescales = r->recovery.rescales,
+        .largest_rescale = r->recovery.largest_rescale,
     };
 }
 

@@ -214,6 +214,26 @@ START_TEST(coarse_to_fine_ends_at_the_resolution)
     ck_assert_uint_eq(tk_run_curve(run)->nvert, (size_t)ceil(2.5 * m.ropelength));
     tk_stop_reason why;
     const tk_step_report *last = run_watched(run, &o, "coarse to fine trefoil", &why);
+    /* The refinement makes the resampled polygon feasible by Newton steps,
+     * not by scaling it up: its ropelength stays within 0.1% of the coarse
+     * one's (a scaled-up curve loses every contact and its length). */
+    size_t nh = 0, refined = 0;
+    const tk_step_report *h = tk_run_history(run, &nh);
+    for (size_t i = 1; i < nh; i++) {
+        /* (an escape deforms and coarsens: fewer vertices) */
+        if (h[i].vertices <= h[i - 1].vertices)
+            continue;
+        refined++;
+        printf("refined from %zu to %zu vertices at step %ld: ropelength %.6f then %.6f\n",
+               h[i - 1].vertices, h[i].vertices, h[i].step, h[i - 1].ropelength,
+               h[i].ropelength);
+        ck_assert_msg(h[i].ropelength <= 1.001 * h[i - 1].ropelength, "%.6f after %.6f",
+                      h[i].ropelength, h[i - 1].ropelength);
+    }
+    ck_assert_uint_ge(refined, 1);
+    tk_run_timing t;
+    tk_run_timing_get(run, &t);
+    ck_assert_int_eq(t.rescales, 0);
     if (!quick()) {
         ck_assert_int_eq(why, TK_STOP_CHANGE);
         ck_assert_uint_eq(last->vertices, (size_t)ceil(5 * m.ropelength));
@@ -311,6 +331,66 @@ START_TEST(round_hopf_start_with_continuum_of_contacts)
     double rope = tighten(c, &o, "round hopf", &why);
     ck_assert(why == TK_STOP_STEPS || why == TK_STOP_STALLED || why == TK_STOP_CHANGE);
     ck_assert(rope < 8 * M_PI * 1.05);
+    tk_curve_free(&c);
+}
+END_TEST
+
+START_TEST(recovery_restores_thousands_of_contacts_without_rescaling)
+{
+    /* The round Hopf link: every vertex of each ring is at distance 1 from
+     * the other ring, thousands of struts at 300 vertices a ring (a
+     * vertex is near several edges).  Shrunk by
+     * 1e-3 about the origin, every one of them is violated by 1e-3 of the
+     * diameter; the run's error recovery (a start may overstep by up to
+     * its overstep tolerance, here 2e-3) must restore the thickness by
+     * Newton steps on the violated constraints, not by rescaling the
+     * curve. */
+    const size_t per_ring = 300;
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_hopf(per_ring, &c, NULL), TK_OK);
+    tk_curve_scale(c, 1.0 - 1e-3);
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, NULL), TK_OK);
+    ck_assert(m.thickness < 1.0 - 0.9e-3);
+    tk_options o = TK_OPTIONS_INIT;
+    o.overstep_tolerance = 2e-3;
+    o.max_steps = 1;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    const tk_step_report *first = tk_run_latest(run);
+    printf("recovery at %zu struts: %d corrections\n", first->struts, first->corrections);
+    ck_assert_uint_ge(first->struts, 2000);
+    tk_run_timing t;
+    tk_run_timing_get(run, &t);
+    ck_assert_int_eq(t.rescales, 0);
+    const tk_curve *d = tk_run_curve(run);
+    ck_assert_int_eq(tk_thickness_measure(d, NULL, &m, NULL), TK_OK);
+    /* the correction tolerance: a tenth of the active one, 3e-4 */
+    ck_assert_msg(m.thickness >= 1.0 - 3e-5, "thickness %.9f", m.thickness);
+    double moved = 0.0;
+    for (size_t i = 0; i < 3 * d->nvert; i += 3) {
+        double dx = d->xyz[i] - c->xyz[i], dy = d->xyz[i + 1] - c->xyz[i + 1],
+               dz = d->xyz[i + 2] - c->xyz[i + 2];
+        moved = fmax(moved, sqrt(dx * dx + dy * dy + dz * dz));
+    }
+    /* what it costs: a rescaling to the diameter would lengthen the
+     * curve by 1e-3 and lose every contact (all are 1e-3 off, beyond the
+     * active tolerance 3e-4); the Newton steps keep the contacts (counted
+     * above, after the recovery) and deform the curve smoothly (the
+     * vertices at the other ring's centre, near all of it, move most) at
+     * a cost of the same order (0.14%) */
+    double grew = tk_curve_length(d) / tk_curve_length(c) - 1.0;
+    printf("recovery moved a vertex by at most %.3g; the length grew by %.3g\n", moved, grew);
+    ck_assert_msg(grew < 2e-3, "the length grew by %.3g", grew);
+    ck_assert_msg(moved < 0.1, "a vertex moved by %.3g", moved);
+    /* and the run goes on from there */
+    tk_stop_reason why;
+    run_watched(run, &o, "recovered hopf", &why);
+    ck_assert_int_eq(why, TK_STOP_STEPS);
+    tk_run_timing_get(run, &t);
+    ck_assert_int_eq(t.rescales, 0);
+    tk_run_free(&run);
     tk_curve_free(&c);
 }
 END_TEST
@@ -921,6 +1001,7 @@ int main(void)
     tcase_add_test(tc, cancellation_stops_within_one_step);
     tcase_add_test(tc, parallel_runs_equal_serial_runs);
     tcase_add_test(tc, round_hopf_start_with_continuum_of_contacts);
+    tcase_add_test(tc, recovery_restores_thousands_of_contacts_without_rescaling);
     tcase_add_test(tc, unknot_and_unlink_are_handled);
     tcase_add_test(tc, hopf_link_tightens_towards_8_pi);
     tcase_add_test(tc, generated_hopf_link_tightens_to_8_pi);

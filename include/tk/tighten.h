@@ -234,6 +234,12 @@ typedef struct tk_run_timing {
     long nnls_solves, nnls_iterations, factorisations;
     double invariants;   /* the knot type computed and compared (included
                             in total) */
+    /* Error recovery's last resorts: steps undone and taken again shorter
+     * because Newton steps could not restore the thickness, and rescalings
+     * of the whole curve about its centroid (not counting autoscale) with
+     * the largest factor - 1. */
+    long undone_steps, rescales;
+    double largest_rescale;
 } tk_run_timing;
 
 void tk_run_timing_get(const tk_run *r, tk_run_timing *out);
