@@ -88,7 +88,7 @@ BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
 .SECONDARY:
 
-.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-service \
+.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-starts bench-service \
 	lint headers clean fuzz fuzz-bin
 
 WEB_OUT := $(BUILD)/web
@@ -196,7 +196,7 @@ run: deps all
 	@echo "tightknot: starting the service on http://127.0.0.1:$(PORT)/ (Ctrl-C stops it)"
 	$(Q)exec $(DAEMON) $(RUN_ARGS)
 
-bench: bench-struts bench-tighten bench-steps bench-service
+bench: bench-struts bench-tighten bench-steps bench-starts bench-service
 
 bench-struts: deps all $(BENCH_BIN)
 	$(Q)$(BUILD)/bench/struts $(CATALOGUE)
@@ -206,6 +206,9 @@ bench-tighten: deps all $(BENCH_BIN)
 
 bench-steps: deps all $(BENCH_BIN)
 	$(Q)$(BUILD)/bench/steps $(CATALOGUE)
+
+bench-starts: deps all $(BENCH_BIN)
+	$(Q)$(BUILD)/bench/starts $(CATALOGUE)
 
 bench-service: deps all
 	$(Q)./bench/service.sh $(BUILD) $(CATALOGUE)

@@ -4,7 +4,8 @@
  * tightened at the same resolution for the same wall time, and each run
  * prints its final ropelength, its excess over the best known value, when
  * it came within 0.5% and 0.1% of it on its final polygon, the escapes it
- * tried and whether the type held.  Two starts of one type that end apart
+ * tried and how many improved, and why it stopped (a run whose knot type
+ * changed fails, and says so there).  Two starts of one type that end apart
  * found different critical configurations: at most one is tight.
  * Prints figures; never fails on time.
  *
