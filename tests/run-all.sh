@@ -92,6 +92,9 @@ if [ "$unit_only" -eq 0 ]; then
         echo "$t ($dir): $line"
         grep -E '^SKIP ' "$log"
         [ "$f" -eq 0 ] || grep -E '^FAIL|^not ok|^# fail|Error' "$log" | head -n 40
+        # a ThreadSanitizer report: where the two accesses were
+        [ "$f" -eq 0 ] || grep -E '^  (Write|Read|Previous|Atomic|Location|Thread T)|^    #[0-9] ' "$log" |
+            head -n 60
     done
 fi
 
