@@ -18,8 +18,10 @@
  *      mid-step included, found again with the tree) is within the
  *      overstep tolerance (section 4.5);
  *   5. error recovery: while some constraint is violated beyond the
- *      correction tolerance, Newton steps with the minimum-norm solution of
- *      A^T du = -R (section 4.6); rescaling only if that fails.
+ *      correction tolerance, Newton steps with the damped minimum-norm
+ *      solution of A^T du = -R (section 4.6); a step they cannot restore is
+ *      undone and taken shorter, and rescaling the curve is left for a
+ *      leftover of 1e-6 (a resampled polygon is restored the same way).
  * The flow keeps the tube embedded, so it cannot change the knot or link
  * type; resampling and recovery move the curve in ways its constraints
  * do not cover, so the type (tk/invariants.h) of the start is compared
