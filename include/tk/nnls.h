@@ -93,17 +93,19 @@ int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *
 
 /* The proximal problem (opts->proximal = mu > 0) is strictly convex: its
  * answer is unique and moves continuously with A, b and the centre c, and
- * block pivoting from c's support finishes without the fallback (its
- * normal matrix M + mu I is positive definite, of condition at most about
- * (1 + mu) / mu).  Repeated with the answer as the next centre it is the
- * proximal point method, whose iterates converge to the plain problem's
- * answer nearest the first centre: along an eigenvalue lambda of the scaled
- * A^T A the distance shrinks by mu / (lambda + mu) a time, so A x is off
- * by at most sqrt(mu) / 2 times |c - x*| (scaled) after one.  The flow
- * solves one proximal problem a step, centred at the last step's forces:
- * where constraints are many and dependent (thousands of struts on nearly
- * parallel strands), the plain problem's answer is not unique and block
- * pivoting stalls on it.  The report's residual is ||A x - b||. */
+ * its normal matrix M + mu I is positive definite, of condition at most
+ * about (1 + mu) / mu, so for a moderate mu (1e-2) block pivoting from c's
+ * support finishes in a few pivots; as mu shrinks towards 0 it becomes the
+ * plain problem again, fallback included.  Repeated with the answer as the
+ * next centre it is the proximal point method, whose iterates converge to
+ * the plain problem's answer nearest the first centre: along an eigenvalue
+ * lambda of the scaled A^T A the distance shrinks by mu / (lambda + mu) a
+ * time, so A x is off by at most sqrt(mu) / 2 times |c - x*| (scaled)
+ * after one.  The flow solves a few a step, the first centred at the last
+ * step's forces (engine/motion.c): where constraints are many and
+ * dependent (thousands of struts on nearly parallel strands), the plain
+ * problem's answer is not unique and block pivoting stalls on it.  The
+ * report's residual is ||A x - b||. */
 
 /* The minimum-norm solution du (m entries) of the underdetermined system
  * A^T du = r (r has n entries), du = A y with (A^T A + delta D) y = r,
