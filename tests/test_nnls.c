@@ -775,6 +775,19 @@ START_TEST(repeat_solves_are_identical)
 }
 END_TEST
 
+/* g = A^T du - r (n entries). */
+static void transpose_residual(const cholmod_sparse *A, const double *du, const double *r,
+                               double *g)
+{
+    const int *Ap = A->p, *Ai = A->i;
+    const double *Ax = A->x;
+    for (size_t j = 0; j < A->ncol; j++) {
+        g[j] = -r[j];
+        for (int e = Ap[j]; e < Ap[j + 1]; e++)
+            g[j] += Ax[e] * du[Ai[e]];
+    }
+}
+
 /* Checks min_norm on A (m x n, n <= m small enough for dense QR when
  * dense is true). */
 static void check_min_norm(tk_nnls *s, const cholmod_sparse *A, tkt_rng *r, bool dense,
@@ -789,15 +802,7 @@ static void check_min_norm(tk_nnls *s, const cholmod_sparse *A, tkt_rng *r, bool
                   err.message);
     ck_assert(delta == 0.0);
     /* A^T du = r */
-    {
-        const int *Ap = A->p, *Ai = A->i;
-        const double *Ax = A->x;
-        for (size_t j = 0; j < n; j++) {
-            g[j] = -rr[j];
-            for (int e = Ap[j]; e < Ap[j + 1]; e++)
-                g[j] += Ax[e] * du[Ai[e]];
-        }
-    }
+    transpose_residual(A, du, rr, g);
     ck_assert_msg(vnorm(g, n) <= 1e-10 * vnorm(rr, n), "%s: ||A^T du - r|| = %g", what,
                   vnorm(g, n));
     if (dense) {
@@ -912,17 +917,13 @@ START_TEST(damped_min_norm_steps)
         ck_assert(used >= delta);
         const int *Ap = A->p, *Ai = A->i;
         const double *Ax = A->x;
+        transpose_residual(A, du, rr, g);
         for (size_t i = 0; i < m; i++)
             kkt[i] = used * du[i];
         for (size_t j = 0; j < n; j++) {
-            double d = 0.0, gj = -rr[j];
-            for (int e = Ap[j]; e < Ap[j + 1]; e++) {
-                d += Ax[e] * Ax[e];
-                gj += Ax[e] * du[Ai[e]];
-            }
-            g[j] = gj;
+            double d = column_norm(A, j);
             for (int e = Ap[j]; e < Ap[j + 1]; e++)
-                kkt[Ai[e]] += Ax[e] * gj / d;
+                kkt[Ai[e]] += Ax[e] * g[j] / (d * d);
         }
         double scale = used * vnorm(du, m) + 1e-300;
         ck_assert_msg(vnorm(kkt, m) <= 1e-6 * fmax(scale, vnorm(rr, n)),
