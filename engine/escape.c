@@ -213,7 +213,8 @@ int tk_escape_before_step(tk_run *r, tk_error *err)
 int tk_escape_finish(tk_run *r, bool *restored, tk_error *err)
 {
     *restored = false;
-    if (r->escape.nlog == 0)
+    /* a resumed run's tries were before it: its best is kept all the same */
+    if (tk_escape_tries(r) == 0)
         return TK_OK;
     int rc = note(r, err);
     if (rc || !r->escape.best)
