@@ -1053,6 +1053,56 @@ done:
     return rc;
 }
 
+/* The columns F (nf of them) of A, each divided by its norm: P (m x nf),
+ * with P P' = A D^-1 A' over F. */
+static void build_scaled(const cholmod_sparse *A, const int *F, size_t nf,
+                         const double *inv_norm, cholmod_sparse *P)
+{
+    int *Pp = P->p, *Pi = P->i;
+    double *Px = P->x;
+    const int *Ai = A->i;
+    const double *Ax = A->x;
+    size_t e = 0;
+    for (size_t q = 0; q < nf; q++) {
+        size_t lo, hi;
+        col_span(A, (size_t)F[q], &lo, &hi);
+        Pp[q] = (int)e;
+        for (size_t k = lo; k < hi; k++, e++) {
+            Pi[e] = Ai[k];
+            Px[e] = Ax[k] * inv_norm[F[q]];
+        }
+    }
+    Pp[nf] = (int)e;
+    P->ncol = nf;
+    P->sorted = A->sorted;
+    P->packed = 1;
+}
+
+/* Whether the damped step is cheaper in its primal form, (P P' + delta I)
+ * du = P c with P P' of order m, than in its dual one, (P' P + delta I) z
+ * = c of order nf: by the entries of the two normal matrices, the sum of
+ * squared row counts of P against that of its squared column counts.  A
+ * vertex touching a whole strand (the round Hopf link: every vertex near
+ * the other ring's centre is equidistant from all of it) puts a dense
+ * block of its struts into the dual matrix, and only one dense row into
+ * the primal one. */
+static bool primal_is_smaller(const cholmod_sparse *A, const int *F, size_t nf, int *rowcount)
+{
+    const int *Ai = A->i;
+    double dual = 0.0, primal = 0.0;
+    memset(rowcount, 0, A->nrow * sizeof *rowcount);
+    for (size_t q = 0; q < nf; q++) {
+        size_t lo, hi;
+        col_span(A, (size_t)F[q], &lo, &hi);
+        primal += (double)(hi - lo) * (double)(hi - lo);
+        for (size_t e = lo; e < hi; e++)
+            rowcount[Ai[e]]++;
+    }
+    for (size_t k = 0; k < A->nrow; k++)
+        dual += (double)rowcount[k] * (double)rowcount[k];
+    return primal < dual;
+}
+
 int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, double delta_min,
                      double *du, double *delta_used, tk_error *err)
 {
@@ -1083,8 +1133,8 @@ int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, doubl
     F = malloc(n * sizeof *F);
     next = malloc(m * sizeof *next);
     c = malloc(n * sizeof *c);
-    z = malloc(n * sizeof *z);
-    res = malloc(n * sizeof *res);
+    z = malloc((n > m ? n : m) * sizeof *z);
+    res = malloc((n > m ? n : m) * sizeof *res);
     inv_norm = malloc(n * sizeof *inv_norm);
     if (!F || !next || !c || !z || !res || !inv_norm) {
         rc = tk_error_set(err, TK_ENOMEM, "out of memory for min-norm (%zu columns)", n);
@@ -1108,12 +1158,18 @@ int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, doubl
     }
     if (nf == 0)
         goto done;
-    T = cholmod_allocate_sparse(n, m, matrix_nnz(A), 1, 1, 0, CHOLMOD_REAL, &s->cc);
+    /* delta = 0 needs the dual form: P P' is singular below full rank */
+    bool primal = delta_min > 0.0 && primal_is_smaller(A, F, nf, next);
+    T = primal ? cholmod_allocate_sparse(m, n, matrix_nnz(A), 1, 1, 0, CHOLMOD_REAL, &s->cc)
+               : cholmod_allocate_sparse(n, m, matrix_nnz(A), 1, 1, 0, CHOLMOD_REAL, &s->cc);
     if (!T) {
         rc = cholmod_failure(s, "allocate", err);
         goto done;
     }
-    build_transpose(A, F, nf, inv_norm, T, next);
+    if (primal)
+        build_scaled(A, F, nf, inv_norm, T);
+    else
+        build_transpose(A, F, nf, inv_norm, T, next);
     nnls_factor f = {NULL, 0.0, 1.0, 0, false};
     if ((rc = factor_normal(s, T, NULL, delta_min, true, NNLS_DEFAULT_RCOND_FLOOR, &f, err)) !=
         TK_OK)
@@ -1122,10 +1178,18 @@ int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, doubl
      * different targets), so the refinement stays on the regularised
      * system: iterated Tikhonov would blow its null-space part up by
      * 1 / delta a step */
-    if ((rc = normal_solve(s, T, &f, c, z, du, res, f.delta > 0.0 ? 2 : 1, f.delta, err)) !=
-        TK_OK)
-        goto done;
-    t_transpose_times(T, z, du);
+    if (primal) {
+        /* du = (P P' + delta I)^-1 P c: the same step, by P (P' P +
+         * delta I)^-1 = (P P' + delta I)^-1 P */
+        t_times(T, c, z);
+        if ((rc = normal_solve(s, T, &f, z, du, c, res, 2, f.delta, err)) != TK_OK)
+            goto done;
+    } else {
+        if ((rc = normal_solve(s, T, &f, c, z, du, res, f.delta > 0.0 ? 2 : 1, f.delta, err)) !=
+            TK_OK)
+            goto done;
+        t_transpose_times(T, z, du);
+    }
     if (delta_used)
         *delta_used = f.delta;
 

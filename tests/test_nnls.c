@@ -895,7 +895,8 @@ END_TEST
 START_TEST(damped_min_norm_steps)
 {
     /* More columns than rows (n > m: inconsistent, as recovery's violated
-     * struts outnumber the coordinates): with damping delta the answer
+     * struts outnumber the coordinates), many more (the primal form is
+     * then the smaller one) and fewer: with damping delta the answer
      * satisfies the damped least-squares optimality condition
      * A D^-1 (A^T du - r) + delta du = 0, D = diag(A^T A), checked here
      * from A itself (to 1e-6: the damped system's condition is up to
@@ -904,9 +905,10 @@ START_TEST(damped_min_norm_steps)
     cholmod_common *cc = tk_nnls_common(s);
     tkt_rng r = {29};
     const double deltas[3] = {1e-8, 1e-6, 1e-3};
-    for (int trial = 0; trial < 30; trial++) {
-        size_t V = 3 + (size_t)(tkt_rng_next(&r) % 6), n = 3 * V + 1 + tkt_rng_next(&r) % 20;
-        size_t m = 3 * V;
+    for (int trial = 0; trial < 45; trial++) {
+        size_t V = 3 + (size_t)(tkt_rng_next(&r) % 6), m = 3 * V;
+        size_t shape = (size_t)trial / 3 % 3, extra = tkt_rng_next(&r) % 20;
+        size_t n = shape == 0 ? m + 1 + extra : shape == 1 ? 4 * m + extra : 1 + extra % (m / 2);
         cholmod_sparse *A = flow_matrix(cc, &r, V, n);
         double *rr = random_vector(&r, n), *du = malloc(m * sizeof *du);
         double *g = malloc(n * sizeof *g), *kkt = malloc(m * sizeof *kkt);
