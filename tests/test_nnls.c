@@ -444,6 +444,47 @@ START_TEST(wide_problems_match_enumeration)
 }
 END_TEST
 
+/* Wide flow problems large enough that Lawson and Hanson modify their
+ * factor hundreds of times (rows added and deleted, and rebuilt after
+ * many): the answer still meets the KKT conditions. */
+START_TEST(wide_flow_problems_meet_kkt)
+{
+    tk_nnls *s = new_solver();
+    cholmod_common *cc = tk_nnls_common(s);
+    tkt_rng r = {2026};
+    int fallback = 0, rebuilt = 0;
+    for (int trial = 0; trial < 8; trial++) {
+        size_t V = trial < 4 ? 150 : 400, m = 3 * V;
+        size_t n = (size_t)((1.7 + 0.1 * (trial % 4)) * (double)m);
+        cholmod_sparse *A = flow_matrix(cc, &r, V, n);
+        double *b = random_vector(&r, m);
+        double *x = malloc(n * sizeof *x);
+        tk_nnls_report rep;
+        char what[64];
+        snprintf(what, sizeof what, "wide flow V=%zu n=%zu", V, n);
+        ck_assert_msg(solve(s, A, b, x, NULL, &rep) == TK_OK, "%s: not converged", what);
+        fallback += rep.used_fallback;
+        /* the factor is modified, not built afresh, at most iterations */
+        if (rep.used_fallback)
+            ck_assert_msg(rep.factorisations < rep.iterations / 4,
+                          "%s: %d factorisations in %d iterations", what, rep.factorisations,
+                          rep.iterations);
+        rebuilt += rep.used_fallback && rep.factorisations > 1;
+        double rn = assert_kkt(A, b, x, 1e-9, what);
+        ck_assert_msg(tkt_reldiff(rn, rep.residual) < 1e-9, "%s: residual %g vs %g", what, rn,
+                      rep.residual);
+        printf("%s: %d iterations, %d factorisations, %zu passive%s\n", what, rep.iterations,
+               rep.factorisations, rep.passive, rep.used_fallback ? ", fallback" : "");
+        free(b);
+        free(x);
+        cholmod_free_sparse(&A, cc);
+    }
+    ck_assert_int_ge(fallback, 6);
+    ck_assert_int_ge(rebuilt, 1);
+    tk_nnls_free(&s);
+}
+END_TEST
+
 /* Builds a small rank-deficient matrix of the given kind from a random
  * flow-like one (V vertices, n0 independent columns). */
 static cholmod_sparse *rank_deficient(cholmod_common *cc, tkt_rng *r, int kind, size_t V,
@@ -1113,6 +1154,7 @@ int main(void)
     tcase_add_test(tc, kkt_on_random_flow_problems);
     tcase_add_test(tc, matches_dense_enumeration);
     tcase_add_test(tc, wide_problems_match_enumeration);
+    tcase_add_test(tc, wide_flow_problems_meet_kkt);
     tcase_add_test(tc, rank_deficient_problems);
     tcase_add_test(tc, scale_invariance);
     tcase_add_test(tc, duplicate_pair_is_regularised);
