@@ -87,9 +87,10 @@
       "steps")                                                                               \
     X(change_window, SIZE, 20, 1, 1e8, NULL, "steps of the change criterion")               \
     X(active_tolerance, REAL, 3e-4, 1e-12, 0.4, NULL,                                        \
-      "constraints this close are active; a third of it each time the ropelength all but "   \
-      "stops falling, four times at most (the polishing; the overstep tolerance then "       \
-      "stays below it)")                                                                     \
+      "constraints this close are active (at most; a fine polygon uses 0.3 times its "       \
+      "squared mean edge in diameters if smaller); a third of it each time the ropelength "  \
+      "all but stops falling, four times at most (the polishing; the overstep tolerance "    \
+      "then stays below it)")                                                                \
     X(overstep_tolerance, REAL, 1e-5, 1e-12, 0.09, "overstep",                               \
       "largest constraint violation a step may make, as a fraction of the diameter; "        \
       "violations are corrected down to a tenth of it")                                      \
