@@ -53,12 +53,10 @@ void tk_escape_free(tk_run *r)
 
 bool tk_escape_converged(const tk_run *r)
 {
-    size_t n = r->life.nhistory;
-    if (!tk_schedule_final(r) || n <= r->schedule.resampled_from + ESCAPE_WINDOW)
-        return false;
-    double before = r->life.history[n - 1 - ESCAPE_WINDOW].ropelength;
-    double now = r->life.history[n - 1].ropelength;
-    return before - now < ESCAPE_CHANGE * now;
+    double fall;
+    return tk_schedule_final(r) &&
+           tk_history_fall(r, r->schedule.resampled_from, ESCAPE_WINDOW, &fall) &&
+           fall < ESCAPE_CHANGE;
 }
 
 /* The run's curve, on the final polygon, as the result of the try under

@@ -202,6 +202,17 @@ static inline double tk_norm(const double *v, size_t n)
  * with a message that begins with `when` ("resampling to 400 vertices"). */
 int tk_type_check(tk_run *r, const char *when, tk_error *err);
 
+/* How much the ropelength fell over the last `window` entries of the
+ * history, relative: the lowest over them below the lowest over the
+ * window before (entries from `from` on).  Lowest, not last: before the
+ * first contact the thickness is often one vertex's curvature bound,
+ * which wavers from step to step, and a run still falling by 0.4% in 300
+ * steps (T(3,7) at 10,000 vertices) ended its window on a spike above
+ * the ropelength 300 steps before and was taken for converged.  False
+ * (and *fall untouched) while the history since `from` holds no more
+ * than `window` entries. */
+bool tk_history_fall(const tk_run *r, size_t from, size_t window, double *fall);
+
 /* ---- active.c ---- */
 
 /* The active constraints of curve c into *set (the finder must be fitted

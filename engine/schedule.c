@@ -416,13 +416,11 @@ int tk_schedule_before_step(tk_run *r, tk_error *err)
  * before its error recovery (which then works to the new tolerances). */
 void tk_schedule_watch(tk_run *r)
 {
-    size_t n = r->life.nhistory;
-    if (!(n > r->schedule.polish_from + POLISH_WINDOW && r->schedule.polish_level < POLISH_LEVELS))
-        return;
-    double before = r->life.history[n - 1 - POLISH_WINDOW].ropelength;
-    double now = r->life.history[n - 1].ropelength;
-    if (before - now < POLISH_CHANGE * polish_scale(r) * now && !tk_schedule_move_on(r)) {
+    double fall;
+    if (r->schedule.polish_level < POLISH_LEVELS &&
+        tk_history_fall(r, r->schedule.polish_from, POLISH_WINDOW, &fall) &&
+        fall < POLISH_CHANGE * polish_scale(r) && !tk_schedule_move_on(r)) {
         r->schedule.polish_level++;
-        r->schedule.polish_from = n;
+        r->schedule.polish_from = r->life.nhistory;
     }
 }

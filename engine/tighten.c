@@ -59,6 +59,22 @@ void tk_run_free(tk_run **p)
     *p = NULL;
 }
 
+bool tk_history_fall(const tk_run *r, size_t from, size_t window, double *fall)
+{
+    size_t n = r->life.nhistory;
+    if (window == 0 || n <= from + window)
+        return false;
+    const tk_step_report *h = r->life.history;
+    size_t split = n - window, first = split > from + window ? split - window : from;
+    double before = INFINITY, recent = INFINITY;
+    for (size_t k = first; k < split; k++)
+        before = fmin(before, h[k].ropelength);
+    for (size_t k = split; k < n; k++)
+        recent = fmin(recent, h[k].ropelength);
+    *fall = (before - recent) / recent;
+    return true;
+}
+
 static int record(tk_run *r, tk_step_report *rep, tk_error *err)
 {
     tk_measure m;
@@ -235,6 +251,7 @@ static void check_stop(tk_run *r)
     const tk_options *o = &r->opt;
     const tk_step_report *s = &r->life.latest;
     tk_stop_reason stop = r->life.stop;
+    double fall;
     if (atomic_load(&r->life.cancel))
         stop = TK_STOP_CANCELLED;
     else if (o->max_steps > 0 && s->step >= o->max_steps)
@@ -245,13 +262,10 @@ static void check_stop(tk_run *r)
         ; /* convergence is judged on the final polygon only */
     else if (o->min_residual > 0.0 && s->residual < o->min_residual)
         stop = TK_STOP_RESIDUAL;
-    else if (o->min_change > 0.0 && o->change_window > 0 &&
-             r->life.nhistory > r->schedule.resampled_from + o->change_window) {
-        /* within one polygon: a resampled one starts a little longer */
-        double before = r->life.history[r->life.nhistory - 1 - o->change_window].ropelength;
-        if ((before - s->ropelength) / s->ropelength < o->min_change)
-            stop = TK_STOP_CHANGE;
-    }
+    else if (o->min_change > 0.0 &&
+             tk_history_fall(r, r->schedule.resampled_from, o->change_window, &fall) &&
+             fall < o->min_change)
+        stop = TK_STOP_CHANGE; /* within one polygon: a resampled one starts a little longer */
     if (stop == TK_STOP_NONE && tk_stepping_stalled(r) && !tk_schedule_move_on(r))
         stop = TK_STOP_STALLED;
     /* converged on the final polygon: an escape, while tries and budget

@@ -810,7 +810,7 @@ static tk_run *escaping_run(unsigned long long seed)
     o.autoscale = true;
     o.escapes = 2;
     o.seed = seed;
-    o.max_steps = 1500; /* the first escape starts after step 952 */
+    o.max_steps = 1500; /* the first escape starts after step 928 */
     tk_run *run = NULL;
     tk_error err;
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
@@ -850,7 +850,13 @@ START_TEST(escapes_keep_the_best_and_repeat)
     const tk_curve *cb = tk_run_curve(b), *co = tk_run_curve(other);
     ck_assert_uint_eq(cb->nvert, c->nvert);
     ck_assert(memcmp(c->xyz, cb->xyz, 3 * c->nvert * sizeof *c->xyz) == 0);
-    ck_assert(co->nvert != c->nvert ||
+    /* (its escapes deform differently; the curve returned is the same
+     * when neither improved on the first tightening) */
+    size_t no = 0;
+    const tk_escape *eo = tk_run_escapes(other, &no);
+    ck_assert_uint_ge(no, 1);
+    ck_assert(eo[0].reached != e[0].reached || eo[0].amplitude != e[0].amplitude ||
+              co->nvert != c->nvert ||
               memcmp(c->xyz, co->xyz, 3 * c->nvert * sizeof *c->xyz) != 0);
     tk_run_free(&a);
     tk_run_free(&b);
