@@ -126,6 +126,142 @@ static void frame(uint64_t *s, double e1[3], double e2[3], double e3[3])
     tk_cross3(e3, e1, e2);
 }
 
+/* Whether the pictures of edges i and j (i < j, not neighbours) of the
+ * projected polygon p (n vertices; x, y and height each) cross, appended
+ * to *list if they do; TK_ENUMERIC when the projection is not generic
+ * there. */
+static int test_pair(const double *p, size_t n, size_t i, size_t j, crossing **list, size_t *m,
+                     size_t *cap, tk_error *err)
+{
+    const double *a = p + 3 * i, *b = p + 3 * ((i + 1) % n);
+    const double *q = p + 3 * j, *d = p + 3 * ((j + 1) % n);
+    double rx = b[0] - a[0], ry = b[1] - a[1], sx = d[0] - q[0], sy = d[1] - q[1];
+    double den = rx * sy - ry * sx;
+    double qx = q[0] - a[0], qy = q[1] - a[1];
+    double scale = sqrt((rx * rx + ry * ry) * (sx * sx + sy * sy));
+    if (fabs(den) <= GENERIC_MARGIN * scale) {
+        /* parallel pictures: generic only if they are apart */
+        if (fabs(qx * ry - qy * rx) <= GENERIC_MARGIN * (rx * rx + ry * ry))
+            return TK_ENUMERIC; /* and on one line: they may overlap */
+        return TK_OK;
+    }
+    double s = (qx * sy - qy * sx) / den, t = (qx * ry - qy * rx) / den;
+    if (s < -GENERIC_MARGIN || s > 1.0 + GENERIC_MARGIN || t < -GENERIC_MARGIN ||
+        t > 1.0 + GENERIC_MARGIN)
+        return TK_OK;
+    if (s < GENERIC_MARGIN || s > 1.0 - GENERIC_MARGIN || t < GENERIC_MARGIN ||
+        t > 1.0 - GENERIC_MARGIN)
+        return TK_ENUMERIC; /* through a vertex's picture */
+    double zi = a[2] + s * (b[2] - a[2]), zj = q[2] + t * (d[2] - q[2]);
+    if (fabs(zi - zj) <= GENERIC_MARGIN * (fabs(zi) + fabs(zj)))
+        return TK_ENUMERIC; /* the strands meet: no over or under */
+    if (*m == *cap) {
+        size_t grown_cap = *cap ? 2 * *cap : 64;
+        crossing *grown = realloc(*list, grown_cap * sizeof *grown);
+        if (!grown)
+            return tk_error_set(err, TK_ENOMEM, "out of memory for crossings");
+        *list = grown;
+        *cap = grown_cap;
+    }
+    double pi = (double)i + s, pj = (double)j + t;
+    crossing *x = &(*list)[(*m)++];
+    x->over = zi > zj ? pi : pj;
+    x->under = zi > zj ? pj : pi;
+    /* (over direction x under direction) . e3; den = r x s */
+    x->sign = (zi > zj) == (den > 0.0) ? 1 : -1;
+    return TK_OK;
+}
+
+/* A uniform grid over the projection's bounding box, each cell listing
+ * the edges whose (slightly widened) boxes meet it: only edges sharing a
+ * cell can cross, so finding the crossings costs about the number of
+ * edges, not its square (100,000 vertices: seconds a projection
+ * otherwise).  Cells are about two mean edges wide, at most about 4n of
+ * them. */
+typedef struct grid {
+    double x0, y0, cell;
+    size_t nx, ny;
+    size_t *start;   /* ncells + 1 */
+    size_t *edge;    /* the edges of cell k: edge[start[k] .. start[k + 1]) */
+    double *box;     /* 4 per edge: x min, y min, x max, y max */
+} grid;
+
+static size_t grid_index(double v, double v0, double cell, size_t count)
+{
+    double k = floor((v - v0) / cell);
+    return k < 0.0 ? 0 : k >= (double)count ? count - 1 : (size_t)k;
+}
+
+static void grid_free(grid *g)
+{
+    free(g->start);
+    free(g->edge);
+    free(g->box);
+}
+
+static int grid_build(const double *p, size_t n, grid *g, tk_error *err)
+{
+    *g = (grid){0};
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}, length = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const double *a = p + 3 * i, *b = p + 3 * ((i + 1) % n);
+        for (int k = 0; k < 2; k++) {
+            lo[k] = fmin(lo[k], a[k]);
+            hi[k] = fmax(hi[k], a[k]);
+        }
+        length += hypot(b[0] - a[0], b[1] - a[1]);
+    }
+    double w = hi[0] - lo[0], h = hi[1] - lo[1];
+    double widen = GENERIC_MARGIN * (w + h) + 1e-300;
+    g->cell = fmax(2.0 * length / (double)n, sqrt(w * h / (4.0 * (double)n)));
+    if (!(g->cell > 0.0))
+        g->cell = fmax(w + h, 1.0);
+    g->x0 = lo[0];
+    g->y0 = lo[1];
+    g->nx = (size_t)fmin(floor(w / g->cell) + 1.0, 4.0 * (double)n + 1.0);
+    g->ny = (size_t)fmin(floor(h / g->cell) + 1.0, 4.0 * (double)n + 1.0);
+    size_t ncells = g->nx * g->ny;
+    g->start = calloc(ncells + 1, sizeof *g->start);
+    g->box = malloc(4 * n * sizeof *g->box);
+    if (!g->start || !g->box)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for a projection's grid");
+    /* count, then place (counting sort by cell) */
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t i = 0; i < n; i++) {
+            const double *a = p + 3 * i, *b = p + 3 * ((i + 1) % n);
+            double *bx = g->box + 4 * i;
+            bx[0] = fmin(a[0], b[0]) - widen;
+            bx[1] = fmin(a[1], b[1]) - widen;
+            bx[2] = fmax(a[0], b[0]) + widen;
+            bx[3] = fmax(a[1], b[1]) + widen;
+            size_t i0 = grid_index(bx[0], g->x0, g->cell, g->nx);
+            size_t i1 = grid_index(bx[2], g->x0, g->cell, g->nx);
+            size_t j0 = grid_index(bx[1], g->y0, g->cell, g->ny);
+            size_t j1 = grid_index(bx[3], g->y0, g->cell, g->ny);
+            for (size_t jy = j0; jy <= j1; jy++)
+                for (size_t ix = i0; ix <= i1; ix++) {
+                    size_t k = jy * g->nx + ix;
+                    if (pass == 0)
+                        g->start[k + 1]++;
+                    else
+                        g->edge[g->start[k]++] = i;
+                }
+        }
+        if (pass == 0) {
+            for (size_t k = 0; k < ncells; k++)
+                g->start[k + 1] += g->start[k];
+            g->edge = malloc((g->start[ncells] ? g->start[ncells] : 1) * sizeof *g->edge);
+            if (!g->edge)
+                return tk_error_set(err, TK_ENOMEM, "out of memory for a projection's grid");
+        }
+    }
+    /* placing moved each start to the next cell's: shift back */
+    for (size_t k = ncells; k > 0; k--)
+        g->start[k] = g->start[k - 1];
+    g->start[0] = 0;
+    return TK_OK;
+}
+
 /* The crossings of the knot seen along e3: for each pair of non-adjacent
  * edges whose pictures cross, where along the knot the under and the over
  * strand pass.  Returns TK_OK, TK_ENUMERIC for a projection that is not
@@ -145,55 +281,32 @@ static int find_crossings(const tk_curve *c, size_t comp, const double e1[3], co
         p[3 * i + 1] = tk_dot3(x, e2);
         p[3 * i + 2] = tk_dot3(x, e3);
     }
-    int rc = TK_OK;
-    for (size_t i = 0; i < n && !rc; i++) {
-        const double *a = p + 3 * i, *b = p + 3 * ((i + 1) % n);
-        for (size_t j = i + 2; j < n && !rc; j++) {
-            if (i == 0 && j == n - 1)
-                continue; /* neighbours across the closing vertex */
-            const double *q = p + 3 * j, *d = p + 3 * ((j + 1) % n);
-            double rx = b[0] - a[0], ry = b[1] - a[1], sx = d[0] - q[0], sy = d[1] - q[1];
-            double den = rx * sy - ry * sx;
-            double qx = q[0] - a[0], qy = q[1] - a[1];
-            double scale = sqrt((rx * rx + ry * ry) * (sx * sx + sy * sy));
-            if (fabs(den) <= GENERIC_MARGIN * scale) {
-                /* parallel pictures: generic only if they are apart */
-                if (fabs(qx * ry - qy * rx) <= GENERIC_MARGIN * (rx * rx + ry * ry))
-                    rc = TK_ENUMERIC; /* and on one line: they may overlap */
-                continue;
-            }
-            double s = (qx * sy - qy * sx) / den, t = (qx * ry - qy * rx) / den;
-            if (s < -GENERIC_MARGIN || s > 1.0 + GENERIC_MARGIN || t < -GENERIC_MARGIN ||
-                t > 1.0 + GENERIC_MARGIN)
-                continue;
-            if (s < GENERIC_MARGIN || s > 1.0 - GENERIC_MARGIN || t < GENERIC_MARGIN ||
-                t > 1.0 - GENERIC_MARGIN) {
-                rc = TK_ENUMERIC; /* through a vertex's picture */
-                continue;
-            }
-            double zi = a[2] + s * (b[2] - a[2]), zj = q[2] + t * (d[2] - q[2]);
-            if (fabs(zi - zj) <= GENERIC_MARGIN * (fabs(zi) + fabs(zj))) {
-                rc = TK_ENUMERIC; /* the strands meet: no over or under */
-                continue;
-            }
-            if (m == cap) {
-                size_t grown_cap = cap ? 2 * cap : 64;
-                crossing *grown = realloc(list, grown_cap * sizeof *grown);
-                if (!grown) {
-                    rc = tk_error_set(err, TK_ENOMEM, "out of memory for crossings");
-                    break;
+    grid g;
+    int rc = grid_build(p, n, &g, err);
+    for (size_t k = 0; !rc && k < g.nx * g.ny; k++)
+        for (size_t u = g.start[k]; !rc && u < g.start[k + 1]; u++)
+            for (size_t v = u + 1; !rc && v < g.start[k + 1]; v++) {
+                size_t i = g.edge[u], j = g.edge[v];
+                if (i > j) {
+                    size_t t = i;
+                    i = j;
+                    j = t;
                 }
-                list = grown;
-                cap = grown_cap;
+                if (j == i + 1 || (i == 0 && j == n - 1))
+                    continue; /* neighbours */
+                const double *bi = g.box + 4 * i, *bj = g.box + 4 * j;
+                double lx = fmax(bi[0], bj[0]), ly = fmax(bi[1], bj[1]);
+                if (lx > fmin(bi[2], bj[2]) || ly > fmin(bi[3], bj[3]))
+                    continue; /* boxes apart */
+                /* a pair sharing several cells is tested in one: where
+                 * its boxes' overlap begins */
+                if (grid_index(ly, g.y0, g.cell, g.ny) * g.nx +
+                        grid_index(lx, g.x0, g.cell, g.nx) !=
+                    k)
+                    continue;
+                rc = test_pair(p, n, i, j, &list, &m, &cap, err);
             }
-            double pi = (double)i + s, pj = (double)j + t;
-            list[m].over = zi > zj ? pi : pj;
-            list[m].under = zi > zj ? pj : pi;
-            /* (over direction x under direction) . e3; den = r x s */
-            list[m].sign = (zi > zj) == (den > 0.0) ? 1 : -1;
-            m++;
-        }
-    }
+    grid_free(&g);
     free(p);
     if (rc) {
         free(list);

@@ -216,6 +216,13 @@ START_TEST(torus_knot_determinants)
                           known[k].p, known[k].q, seed, det_of(c, 0, seed));
         tk_curve_free(&c);
     }
+    /* a fine polygon: edges far shorter than the picture, many to a
+     * cell of the projection's grid, every crossing found once */
+    tk_curve *fine = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 11, 100000, &fine, NULL), TK_OK);
+    for (unsigned long long seed = 1; seed <= 3; seed++)
+        ck_assert_int_eq(det_of(fine, 0, seed), 11);
+    tk_curve_free(&fine);
     tk_curve *round = tkt_regular_polygon(50, 3.0);
     ck_assert_int_eq(det_of(round, 0, 7), 1);
     tk_curve_free(&round);
