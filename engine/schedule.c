@@ -154,6 +154,11 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
 {
     tk_measure m;
     tk_curve **curve = &r->shared.curve;
+    if (start->nvert > TK_RUN_MAX_VERTICES)
+        return tk_error_set(err, TK_ELIMIT,
+                            "%zu vertices: a run holds at most %d (about 2 GiB of memory); "
+                            "tighten a coarser polygon (a resolution resamples it)",
+                            start->nvert, TK_RUN_MAX_VERTICES);
     int rc = tk_curve_copy(start, curve, err);
     if (!rc)
         rc = measure(*curve, &m, err);
@@ -167,10 +172,11 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
                             m.ropelength, START_ROPELENGTH_MAX);
     if (r->opt.resolution > 0.0) {
         double want = ceil(r->opt.resolution * m.ropelength);
-        if (want > 1e7)
+        if (want > TK_RUN_MAX_VERTICES)
             return tk_error_set(err, TK_ELIMIT,
-                                "resolution %g at ropelength %.4g asks for %.0f vertices",
-                                r->opt.resolution, m.ropelength, want);
+                                "resolution %g at ropelength %.4g asks for %.0f vertices: a "
+                                "run holds at most %d (about 2 GiB of memory)",
+                                r->opt.resolution, m.ropelength, want, TK_RUN_MAX_VERTICES);
         r->schedule.coarse_level = r->schedule.coarse_levels = coarse_levels(&r->opt);
         want = ceil(resolution_now(r) * m.ropelength);
         tk_curve *resampled = NULL;

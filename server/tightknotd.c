@@ -36,7 +36,7 @@ int main(int argc, char **argv)
          "threads running the engine (default: one per core)"},
         {"queue-limit", "N", 1, 10000000, &pool_cfg.queue_limit, NULL,
          "queued jobs before submissions get 429 (default 1000)"},
-        {"max-vertices", "N", 3, 100000000, &api.max_vertices, NULL,
+        {"max-vertices", "N", 3, TK_RUN_MAX_VERTICES, &api.max_vertices, NULL,
          "largest knot accepted, after re-resolution (default 200000)"},
         {"max-body", "BYTES", 64, 1ull << 32, &api.max_body, NULL,
          "largest request body (default 16777216)"},

@@ -436,6 +436,34 @@ START_TEST(start_thinner_than_tube_is_refused)
 }
 END_TEST
 
+/* A run larger than TK_RUN_MAX_VERTICES is refused before it takes the
+ * memory: as a start, and as a resolution's resampling. */
+START_TEST(runs_beyond_the_vertex_limit_are_refused)
+{
+    tk_curve *big = tkt_regular_polygon(TK_RUN_MAX_VERTICES + 1, 1e6);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(big, &o, &run, &err), TK_ELIMIT);
+    ck_assert_msg(strstr(err.message, "at most") != NULL, "%s", err.message);
+    ck_assert(run == NULL);
+    tk_curve_free(&big);
+    /* T(3,7), ropelength above 100: resolution 1e4 asks for over a million */
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(3, 7, 300, &c, NULL), TK_OK);
+    o.resolution = 1e4;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_ELIMIT);
+    ck_assert_msg(strstr(err.message, "asks for") != NULL, "%s", err.message);
+    /* just inside: a resolution that asks for fewer runs */
+    o.resolution = 5;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_uint_le(tk_run_curve(run)->nvert, TK_RUN_MAX_VERTICES);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(radius_out_of_the_range_is_refused)
 {
     /* A radius of 1e300 with autoscale once scaled the curve past
@@ -995,6 +1023,7 @@ int main(void)
     TCase *tc = tcase_create("tighten");
     tcase_set_timeout(tc, 900);
     tcase_add_test(tc, start_thinner_than_tube_is_refused);
+    tcase_add_test(tc, runs_beyond_the_vertex_limit_are_refused);
     tcase_add_test(tc, corrected_steps_report_their_forces);
     tcase_add_test(tc, history_and_snapshots);
     tcase_add_test(tc, timing_accounts_for_the_run);

@@ -122,6 +122,13 @@ typedef struct tk_options {
 
 #define TK_OPTIONS_INIT {TK_OPTION_FIELDS(TK_FIELD_DEFAULT)}
 
+/* The most vertices a run holds, its start's or after resampling to its
+ * resolution: runs larger are refused (TK_ELIMIT).  A run's memory grows
+ * with its vertices and contacts (measured peaks: 360 MB for 1,000,000
+ * vertices before any contact; see the README's memory table), and this
+ * many keep it within 2 GiB. */
+#define TK_RUN_MAX_VERTICES 1000000
+
 /* With none of steps, time, residual and change set, the command line and
  * the service stop a run after this many steps. */
 #define TK_DEFAULT_STEPS 1000
