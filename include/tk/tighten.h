@@ -124,9 +124,10 @@ typedef struct tk_options {
 
 /* The most vertices a run holds, its start's or after resampling to its
  * resolution: runs larger are refused (TK_ELIMIT).  A run's memory grows
- * with its vertices and contacts (measured peaks: 360 MB for 1,000,000
- * vertices before any contact; see the README's memory table), and this
- * many keep it within 2 GiB. */
+ * with its vertices and contacts: measured peaks of 360 MB for 1,000,000
+ * vertices before any contact, 145 to 244 MB for the trefoil at 2,400
+ * vertices in contact over 30 minutes (README).  A knot that large in
+ * contact was not measured. */
 #define TK_RUN_MAX_VERTICES 1000000
 
 /* With none of steps, time, residual and change set, the command line and
