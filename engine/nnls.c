@@ -594,6 +594,7 @@ typedef struct nnls_work {
     double *acc;          /* n: a column of the normal matrix, scattered */
     int *touched;         /* n: acc's nonzero entries */
     double *zpos;         /* n: the passive solution, by position */
+    double *rhs;          /* n: T b + mu z_c, by position */
     int lh_updates;       /* rows added or deleted since the factor was built */
 } nnls_work;
 
@@ -629,17 +630,24 @@ static void work_free(nnls_work *w)
     free(w->acc);
     free(w->touched);
     free(w->zpos);
+    free(w->rhs);
 }
 
 /* One fill-reducing order (AMD on A^T A) of all the columns.  A solve
  * visits several passive sets, each a different normal matrix; ordering
  * each afresh was a third of the flow's time.  The order of the whole
  * matrix restricted to a passive set serves as that set's order. */
-static int order_columns(nnls_work *w, tk_error *err)
+/* T = A^T with every column scaled (F is left listing them all). */
+static void transpose_all(nnls_work *w, cholmod_sparse *T)
 {
     for (size_t i = 0; i < w->n; i++)
         w->F[i] = (int)i;
-    build_transpose(w->A, w->F, w->n, w->inv_norm, w->T, w->next);
+    build_transpose(w->A, w->F, w->n, w->inv_norm, T, w->next);
+}
+
+static int order_columns(nnls_work *w, tk_error *err)
+{
+    transpose_all(w, w->T);
     if (!cholmod_amd(w->T, NULL, 0, w->order, &w->s->cc) || w->s->cc.status < CHOLMOD_OK)
         return cholmod_failure(w->s, "amd", err);
     return TK_OK;
@@ -767,7 +775,8 @@ static int lh_alloc(nnls_work *w, tk_error *err)
     w->acc = calloc(n, sizeof *w->acc);
     w->touched = malloc(n * sizeof *w->touched);
     w->zpos = malloc(n * sizeof *w->zpos);
-    if (!w->pos || !w->in_factor || !w->acc || !w->touched || !w->zpos)
+    w->rhs = malloc(n * sizeof *w->rhs);
+    if (!w->pos || !w->in_factor || !w->acc || !w->touched || !w->zpos || !w->rhs)
         return tk_error_set(err, TK_ENOMEM, "out of memory for nnls (%zu columns)", n);
     for (size_t p = 0; p < n; p++)
         w->pos[w->order[p]] = (int)p;
@@ -776,9 +785,14 @@ static int lh_alloc(nnls_work *w, tk_error *err)
     w->R = cholmod_allocate_sparse(n, 1, n, 0, 1, 0, CHOLMOD_REAL, &w->s->cc);
     if (!w->Tall || !w->R)
         return cholmod_failure(w->s, "allocate", err);
-    for (size_t i = 0; i < n; i++)
-        w->F[i] = (int)i;
-    build_transpose(w->A, w->F, n, w->inv_norm, w->Tall, w->next);
+    transpose_all(w, w->Tall);
+    /* the right-hand side T b + mu z_c, by position: fixed for the solve */
+    for (size_t i = 0; i < n; i++) {
+        double v = col_dot(w->A, i, w->b) * w->inv_norm[i];
+        if (w->mu > 0.0)
+            v += w->mu * w->colnorm[i] * w->centre[i];
+        w->rhs[w->pos[i]] = v;
+    }
     return TK_OK;
 }
 
@@ -890,17 +904,10 @@ static int lh_solve(nnls_work *w, bool *singular, double *out, tk_error *err)
         memset(out, 0, n * sizeof *out);
         return TK_OK;
     }
-    /* c = T b + mu z_c by position; zero off the passive set */
+    /* the right-hand side on the passive set, zero off it */
     double *c = w->c, *z = w->zpos, *res = w->res;
-    for (size_t p = 0; p < n; p++) {
-        size_t i = (size_t)w->order[p];
-        c[p] = 0.0;
-        if (w->passive[i]) {
-            c[p] = col_dot(w->A, i, w->b) * w->inv_norm[i];
-            if (w->mu > 0.0)
-                c[p] += w->mu * w->colnorm[i] * w->centre[i];
-        }
-    }
+    for (size_t p = 0; p < n; p++)
+        c[p] = w->passive[w->order[p]] ? w->rhs[p] : 0.0;
     const double *sol;
     memcpy(res, c, n * sizeof *res);
     if ((rc = factor_solve(w->s, w->lhL, res, n, &sol, err)) != TK_OK)
