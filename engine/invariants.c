@@ -225,15 +225,18 @@ static int grid_build(const double *p, size_t n, grid *g, tk_error *err)
     g->box = malloc(4 * n * sizeof *g->box);
     if (!g->start || !g->box)
         return tk_error_set(err, TK_ENOMEM, "out of memory for a projection's grid");
+    for (size_t i = 0; i < n; i++) {
+        const double *a = p + 3 * i, *b = p + 3 * ((i + 1) % n);
+        double *bx = g->box + 4 * i;
+        bx[0] = fmin(a[0], b[0]) - widen;
+        bx[1] = fmin(a[1], b[1]) - widen;
+        bx[2] = fmax(a[0], b[0]) + widen;
+        bx[3] = fmax(a[1], b[1]) + widen;
+    }
     /* count, then place (counting sort by cell) */
     for (int pass = 0; pass < 2; pass++) {
         for (size_t i = 0; i < n; i++) {
-            const double *a = p + 3 * i, *b = p + 3 * ((i + 1) % n);
-            double *bx = g->box + 4 * i;
-            bx[0] = fmin(a[0], b[0]) - widen;
-            bx[1] = fmin(a[1], b[1]) - widen;
-            bx[2] = fmax(a[0], b[0]) + widen;
-            bx[3] = fmax(a[1], b[1]) + widen;
+            const double *bx = g->box + 4 * i;
             size_t i0 = grid_index(bx[0], g->x0, g->cell, g->nx);
             size_t i1 = grid_index(bx[2], g->x0, g->cell, g->nx);
             size_t j0 = grid_index(bx[1], g->y0, g->cell, g->ny);
