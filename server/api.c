@@ -936,11 +936,11 @@ int tk_api_start(const tk_api_config *cfg, tk_pool *pool, tk_store *store, tk_ap
         MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr, MHD_OPTION_THREAD_POOL_SIZE,
         (unsigned)(cfg->threads ? cfg->threads : 2), MHD_OPTION_CONNECTION_LIMIT,
         (unsigned)cfg->max_connections, MHD_OPTION_PER_IP_CONNECTION_LIMIT,
-        (unsigned)cfg->max_per_address, MHD_OPTION_CONNECTION_TIMEOUT, cfg->timeout,
+        (unsigned)cfg->max_per_address, MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg->timeout,
         MHD_OPTION_NOTIFY_COMPLETED, request_done, a, MHD_OPTION_LISTEN_BACKLOG_SIZE, 1024,
         MHD_OPTION_END);
     if (!a->daemon) {
-        tk_error_set(err, TK_EIO, "cannot listen on %s:%u: %s", cfg->bind, cfg->port,
+        tk_error_set(err, TK_EIO, "cannot listen on %s:%zu: %s", cfg->bind, cfg->port,
                      errno ? strerror(errno) : "unknown error");
         tk_api_stop(&a);
         return TK_EIO;
@@ -953,7 +953,7 @@ unsigned tk_api_port(const tk_api *a)
 {
     const union MHD_DaemonInfo *info = MHD_get_daemon_info(a->daemon,
                                                            MHD_DAEMON_INFO_BIND_PORT);
-    return info ? info->port : a->cfg.port;
+    return info ? info->port : (unsigned)a->cfg.port;
 }
 
 size_t tk_api_catalogue_size(const tk_api *a)

@@ -12,12 +12,12 @@
 
 typedef struct tk_api_config {
     const char *bind;       /* IPv4 address */
-    unsigned port;          /* 0: any free one (tk_api_port) */
+    size_t port;            /* 0: any free one (tk_api_port) */
     size_t max_body;        /* larger bodies get 413 */
     size_t max_body_total;  /* bodies held at once over all connections: 503 beyond */
     size_t max_vertices;    /* larger VECT inputs get 422 */
     size_t max_connections, max_per_address;
-    unsigned timeout;       /* seconds an idle connection is kept */
+    size_t timeout;         /* seconds an idle connection is kept */
     size_t threads;         /* threads answering requests */
     const char *web;        /* the page's files, or NULL */
     const char *catalogue;  /* a directory of *.vect offered by name, or NULL */

@@ -12,7 +12,7 @@
 
 #include <jansson.h>
 
-#include "tk/record.h"
+#include "jobopts.h"
 
 typedef enum tk_job_state {
     TK_JOB_QUEUED, TK_JOB_RUNNING, TK_JOB_DONE, TK_JOB_FAILED, TK_JOB_CANCELLED, TK_JOB_STATES
@@ -23,32 +23,8 @@ extern const char *const tk_job_states[TK_JOB_STATES];
 /* The state called name, or -1. */
 int tk_job_state_of(const char *name);
 
-/* A job's options: the engine's run options (their table, by the names
- * the command line uses) and the service's own `every` (a frame every
- * this many steps). */
-typedef struct tk_job_options {
-    tk_options run;
-    long every;
-} tk_job_options;
-#define TK_JOB_OPTIONS_INIT {TK_OPTIONS_INIT, 0}
-extern const tk_field tk_job_option_fields[];
-extern const size_t tk_job_option_nfields;
-
-/* Sets the option `name` from text ("5", "1e-3", "true"): TK_EINVAL with
- * a message naming it when it is unknown, malformed or out of domain. */
-int tk_job_option_set_text(tk_job_options *o, const char *name, const char *text, tk_error *err);
-
-/* Sets the options present in a JSON object; on failure *bad (when not
- * NULL) is the offending name (valid while obj lives) or NULL. */
-int tk_job_options_from_json(tk_job_options *o, const json_t *obj, const char **bad,
-                             tk_error *err);
-
 /* The options of a stored document; TK_EIO when they do not read back. */
 int tk_job_options_of(const json_t *doc, tk_job_options *o, tk_error *err);
-
-/* The options a job runs with: the default step budget when no stop
- * criterion is set, as the command line does. */
-void tk_job_options_complete(tk_job_options *o);
 
 /* A queued job's document, figures unknown (null), options complete. */
 json_t *tk_job_new(const char *name, const tk_job_options *o, size_t components,

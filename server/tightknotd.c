@@ -2,7 +2,6 @@
  * store, starts the workers and the routes, and on SIGINT or SIGTERM stops
  * in order: refuse requests, store the running jobs to resume, close the
  * listener, then free the pool and close the store. */
-#include <getopt.h>
 #include <limits.h>
 #include <signal.h>
 #include <stdio.h>
@@ -12,105 +11,70 @@
 #include <unistd.h>
 
 #include "api.h"
+#include "cli.h"
 
-/* The numeric options: name, bounds, where the value goes, help. */
-typedef struct setting {
-    const char *name, *arg;
-    unsigned long long lo, hi;
-    size_t *size;
-    unsigned *uint;
-    const char *help;
-} setting;
+/* The daemon's numbers, each with its domain and default. */
+typedef struct settings {
+    tk_api_config api;
+    tk_pool_config pool;
+} settings;
+#define ROW(path, fld, kind, dflt, lo, hi, hlp)                                                \
+    TK_FIELD_ROW(settings, path, fld, kind, dflt, lo, hi, #fld, hlp)
+static const tk_field fields[] = {
+    ROW(api.port, port, SIZE, 8080, 0, 65535, "TCP port, 0 for any free one"),
+    ROW(pool.workers, workers, SIZE, 0, 0, 256, "threads running the engine, 0 for one per core"),
+    ROW(pool.queue_limit, queue_limit, SIZE, 1000, 1, 1e7,
+        "queued jobs before submissions get 429"),
+    ROW(api.max_vertices, max_vertices, SIZE, 200000, 3, TK_RUN_MAX_VERTICES,
+        "largest knot accepted, after re-resolution"),
+    ROW(api.max_body, max_body, SIZE, 16 << 20, 64, 0x1p32, "largest request body in bytes"),
+    ROW(api.max_body_total, max_body_total, SIZE, 64 << 20, 64, 0x1p40,
+        "bytes of request bodies held at once over all connections; uploads beyond get 503"),
+    ROW(api.max_connections, max_connections, SIZE, 1000, 1, 100000, "open connections at once"),
+    ROW(api.max_per_address, max_per_address, SIZE, 128, 1, 100000,
+        "open connections from one client address"),
+    ROW(api.timeout, timeout, SIZE, 10, 1, 3600, "seconds a silent connection is kept open"),
+    ROW(api.threads, http_threads, SIZE, 2, 1, 64, "threads answering requests"),
+};
 
 int main(int argc, char **argv)
 {
     const char *db = "var/tightknot.db", *priority = "idle";
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    tk_api_config api = {"127.0.0.1", 8080, 16u << 20, 64u << 20, 200000, 1000, 128, 10, 2,
-                         NULL, NULL};
-    tk_pool_config pool_cfg = {cores > 0 ? (size_t)cores : 1, TK_PRIORITY_IDLE, 1000, 0, 2.0,
-                               2000};
-    const setting settings[] = {
-        {"port", "P", 0, 65535, NULL, &api.port, "TCP port, 0 for any free one (default 8080)"},
-        {"workers", "N", 1, 256, &pool_cfg.workers, NULL,
-         "threads running the engine (default: one per core)"},
-        {"queue-limit", "N", 1, 10000000, &pool_cfg.queue_limit, NULL,
-         "queued jobs before submissions get 429 (default 1000)"},
-        {"max-vertices", "N", 3, TK_RUN_MAX_VERTICES, &api.max_vertices, NULL,
-         "largest knot accepted, after re-resolution (default 200000)"},
-        {"max-body", "BYTES", 64, 1ull << 32, &api.max_body, NULL,
-         "largest request body (default 16777216)"},
-        {"max-body-total", "BYTES", 64, 1ull << 40, &api.max_body_total, NULL,
-         "request bodies held at once over all connections;\n"
-         "                       uploads beyond get 503 (default 67108864)"},
-        {"max-connections", "N", 1, 100000, &api.max_connections, NULL,
-         "open connections at once (default 1000)"},
-        {"max-per-address", "N", 1, 100000, &api.max_per_address, NULL,
-         "open connections from one client address (default 128)"},
-        {"timeout", "SECONDS", 1, 3600, NULL, &api.timeout,
-         "a connection silent this long is closed (default 10)"},
-        {"http-threads", "N", 1, 64, &api.threads, NULL, "threads answering requests (default 2)"},
-    };
-    enum { NSET = sizeof settings / sizeof settings[0] };
-    struct option longs[NSET + 8] = {
-        {"bind", 1, NULL, 'b'}, {"db", 1, NULL, 'd'}, {"catalogue", 1, NULL, 'c'},
-        {"web", 1, NULL, 'w'}, {"worker-priority", 1, NULL, 'p'}, {"help", 0, NULL, 'h'}};
-    for (int i = 0; i < NSET; i++)
-        longs[6 + i] = (struct option){settings[i].name, 1, NULL, 256 + i};
-    for (int opt; (opt = getopt_long(argc, argv, "h", longs, NULL)) != -1;) {
-        char *end = NULL;
-        const setting *s = opt >= 256 ? &settings[opt - 256] : NULL;
-        unsigned long long n = s && optarg[0] != '-' ? strtoull(optarg, &end, 10) : 0;
-        if (s && (!end || end == optarg || *end || n < s->lo || n > s->hi)) {
-            fprintf(stderr, "tightknotd: --%s: '%s' must be a whole number from %llu to %llu\n"
-                    "(tightknotd --help lists the options)\n", s->name, optarg, s->lo, s->hi);
-            return 1;
-        }
-        if (s && s->size)
-            *s->size = (size_t)n;
-        else if (s)
-            *s->uint = (unsigned)n;
-        else if (opt == 'b')
-            api.bind = optarg;
-        else if (opt == 'd')
-            db = optarg;
-        else if (opt == 'c')
-            api.catalogue = optarg;
-        else if (opt == 'w')
-            api.web = optarg;
-        else if (opt == 'p')
-            priority = optarg;
-        if (opt == 'h') {
-            printf("usage: tightknotd [options]\n\n"
-                   "The tightknot service: tightens knots and links given as Geomview VECT\n"
-                   "over an HTTP/JSON API (see openapi.yaml), one job per knot, on a pool of\n"
-                   "worker threads; jobs are kept in a SQLite file and survive restarts.\n\n"
-                   "options:\n"
-                   "  --bind ADDR          IPv4 address to listen on (default 127.0.0.1)\n"
-                   "  --db FILE            job store (default var/tightknot.db; its directory\n"
-                   "                       is created when missing)\n"
-                   "  --catalogue DIR      offer DIR's *.vect files at /v1/catalogue\n"
-                   "  --web DIR            serve the page's files from DIR at /\n"
-                   "  --worker-priority P  how workers yield the CPU to requests: idle\n"
-                   "                       (default: only CPU nothing else wants), low\n"
-                   "                       (niceness 5) or normal (a machine shared with\n"
-                   "                       other busy programs, which idle could starve)\n");
-            for (int i = 0; i < NSET; i++) {
-                int pad = 18 - (int)(strlen(settings[i].name) + strlen(settings[i].arg));
-                printf("  --%s %s%*s%s\n", settings[i].name, settings[i].arg, pad > 0 ? pad : 1, "",
-                       settings[i].help);
-            }
-            printf("  -h, --help           this text\n\n"
-                   "On start it prints the URL it listens on.  SIGINT or SIGTERM stops it\n"
-                   "within a few seconds; running jobs are stored and resume at the next\n"
-                   "start, as do jobs left by a crash.\n");
-            return 0;
-        }
-        if (opt == '?')
-            return fprintf(stderr, "(tightknotd --help lists the options)\n"), 1;
+    settings set = {.api = {.bind = "127.0.0.1"}, .pool = {.flush_seconds = 2.0, .history = 2000}};
+    tk_cli_defaults(fields, sizeof fields / sizeof fields[0], &set);
+    bool help = false;
+    tk_cli cli = {.n = 0};
+    tk_cli_text(&cli, "bind", 0, "ADDR", &set.api.bind, "IPv4 address to listen on (default "
+                "127.0.0.1)");
+    tk_cli_text(&cli, "db", 0, "FILE", &db, "job store (default var/tightknot.db; its "
+                "directory is created when missing)");
+    tk_cli_text(&cli, "catalogue", 0, "DIR", &set.api.catalogue, "offer DIR's *.vect files at "
+                "/v1/catalogue");
+    tk_cli_text(&cli, "web", 0, "DIR", &set.api.web, "serve the page's files from DIR at /");
+    tk_cli_text(&cli, "worker-priority", 0, "P", &priority, "how workers yield the CPU to "
+                "requests: idle (default: only CPU nothing else wants), low (niceness 5) or "
+                "normal (a machine shared with other busy programs, which idle could starve)");
+    tk_cli_fields(&cli, fields, sizeof fields / sizeof fields[0], &set);
+    tk_cli_flag(&cli, "help", 'h', &help, "this text");
+    tk_error err;
+    int npos = 0;
+    if (tk_cli_parse(&cli, argc - 1, argv + 1, &npos, &err))
+        return fprintf(stderr, "tightknotd: %s\n(tightknotd --help lists the options)\n",
+                       err.message), 1;
+    if (help) {
+        printf("usage: tightknotd [options]\n\n"
+               "The tightknot service: tightens knots and links given as Geomview VECT\n"
+               "over an HTTP/JSON API (see openapi.yaml), one job per knot, on a pool of\n"
+               "worker threads; jobs are kept in a SQLite file and survive restarts.\n\n"
+               "options:\n");
+        tk_cli_help(&cli, stdout);
+        printf("\nOn start it prints the URL it listens on.  SIGINT or SIGTERM stops it\n"
+               "within a few seconds; running jobs are stored and resume at the next\n"
+               "start, as do jobs left by a crash.\n");
+        return 0;
     }
-    if (optind < argc)
-        return fprintf(stderr, "tightknotd: unexpected argument '%s'\n", argv[optind]), 1;
+    if (npos > 0)
+        return fprintf(stderr, "tightknotd: unexpected argument '%s'\n", argv[1]), 1;
     static const char *const priorities[] = {"idle", "low", "normal"};
     int k = 0;
     while (k < 3 && strcmp(priority, priorities[k]))
@@ -118,6 +82,11 @@ int main(int argc, char **argv)
     if (k == 3)
         return fprintf(stderr, "tightknotd: --worker-priority: '%s' is not idle, low or "
                        "normal\n", priority), 1;
+    tk_api_config api = set.api;
+    tk_pool_config pool_cfg = set.pool;
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    if (!pool_cfg.workers)
+        pool_cfg.workers = cores > 0 ? (size_t)cores : 1;
     pool_cfg.priority = (tk_priority)k;
     pool_cfg.max_vertices = api.max_vertices;
 
@@ -139,7 +108,6 @@ int main(int argc, char **argv)
     snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - db) : 0, db);
     if (slash && slash != db)
         mkdir(dir, 0777); /* one level, as var/ is */
-    tk_error err;
     tk_store *store = NULL;
     tk_pool *pool = NULL;
     tk_api *server = NULL;

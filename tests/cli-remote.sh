@@ -168,7 +168,7 @@ check $? "a dead server is named: $(cat "$tmp/dead")"
 [ $? -eq 1 ]
 check $? "a non-http URL is a usage error"
 "$tk" remote submit --steps -1 x >/dev/null 2>"$tmp/usage"
-[ $? -eq 1 ] && grep -q "option 'steps'" "$tmp/usage"
+[ $? -eq 1 ] && grep -q -- "--steps: must be from 0" "$tmp/usage"
 check $? "a bad run option is a usage error naming it: $(cat "$tmp/usage")"
 
 summary

@@ -18,7 +18,6 @@
  */
 #include <ctype.h>
 #include <errno.h>
-#include <getopt.h>
 #include <jansson.h>
 #include <limits.h>
 #include <math.h>
@@ -34,6 +33,7 @@
 #include "tk/generate.h"
 #include "tk/invariants.h"
 #include "tk/record.h"
+#include "cli.h"
 #include "jsonmap.h"
 #include "tk/struts.h"
 #include "tk/thickness.h"
@@ -246,58 +246,30 @@ static const char tighten_help_end[] =
 /* The subcommands, as bits: which take which option. */
 enum { CMD_INFO = 1u, CMD_STRUTS = 2u, CMD_GENERATE = 4u, CMD_TIGHTEN = 8u };
 
-/* The command line's own options; tighten also takes every named run
- * option (tk/record.h), as --name with '_' written '-', a BOOL as --name
- * and --no-name. */
-enum {
-    OPT_HELP = 'h',
-    OPT_OUTPUT = 'o',
-    OPT_JSON = 256,
-    OPT_TOLERANCE,
-    OPT_VERTICES,
-    OPT_STRUTS_OUT,
-    OPT_LOG,
-    OPT_SNAPSHOTS,
-    OPT_EVERY,
-    OPT_DISGUISE,
-    OPT_RUN = 512 /* + 2 k: run option k; + 2 k + 1: --no-NAME of a BOOL */
-};
-
-static const struct {
-    struct option o;
-    unsigned cmds;
-} own_options[] = {
-    {{"help", no_argument, NULL, OPT_HELP}, ~0u},
-    {{"json", no_argument, NULL, OPT_JSON}, CMD_INFO | CMD_STRUTS | CMD_TIGHTEN},
-    {{"tolerance", required_argument, NULL, OPT_TOLERANCE}, CMD_INFO | CMD_STRUTS},
-    {{"vertices", required_argument, NULL, OPT_VERTICES}, CMD_GENERATE},
-    {{"disguise", required_argument, NULL, OPT_DISGUISE}, CMD_GENERATE},
-    {{"output", required_argument, NULL, OPT_OUTPUT}, CMD_TIGHTEN},
-    {{"struts", required_argument, NULL, OPT_STRUTS_OUT}, CMD_TIGHTEN},
-    {{"log", required_argument, NULL, OPT_LOG}, CMD_TIGHTEN},
-    {{"snapshots", required_argument, NULL, OPT_SNAPSHOTS}, CMD_TIGHTEN},
-    {{"every", required_argument, NULL, OPT_EVERY}, CMD_TIGHTEN},
-};
-#define NOWN (sizeof own_options / sizeof own_options[0])
-
-#define NAME_SIZE 40
-
 typedef struct cli_args {
     bool help;
     bool json;
     double tolerance;
-    size_t vertices; /* 0: the generator's default */
-    bool disguise;   /* generate: tk_generate_disguise with this seed */
+    size_t vertices;      /* 0: the generator's default */
+    const char *disguise; /* generate: tk_generate_disguise with seed */
     unsigned long long seed;
-    tk_options run;  /* tighten's run options */
+    tk_options run;       /* tighten's run options */
     const char *output, *struts_out, *log_out, *snapshots;
     size_t every;
-    int npos;        /* the arguments that are not options, in order */
+    int npos;             /* the arguments that are not options, in order */
     char **pos;
-    /* the run options' names on the command line ("re-resolve",
-     * "no-coarse"), for getopt_long */
-    char names[2 * 32][NAME_SIZE];
 } cli_args;
+
+/* The command line's own numbers; tighten also takes every named run
+ * option (tk/record.h). */
+#define OWN(fld, kind, dflt, lo, hi, nm) TK_FIELD_ROW(cli_args, fld, fld, kind, dflt, lo, hi, nm, "")
+static const tk_field own_fields[] = {
+    OWN(tolerance, REAL, DEFAULT_TOLERANCE, 0, INFINITY, "tolerance"),
+    OWN(vertices, SIZE, 0, 0, 0x1p53, "vertices"), /* 0: the generator's default */
+    OWN(every, SIZE, 100, 1, 0x1p53, "every"),
+    OWN(seed, SEED, 0, 0, 0x1p53, "disguise"),
+};
+enum { OWN_TOLERANCE, OWN_VERTICES, OWN_EVERY, OWN_SEED };
 
 /* Prints "tightknot CMD: message" and a pointer to the help on stderr;
  * returns EXIT_USAGE. */
@@ -318,17 +290,6 @@ static int usage_error(const char *cmd, const char *fmt, ...)
     return EXIT_USAGE;
 }
 
-static int parse_real(const char *cmd, const char *what, const char *text, double *out)
-{
-    char *end = NULL;
-    errno = 0;
-    double x = strtod(text, &end);
-    if (end == text || *end != '\0' || errno == ERANGE || !isfinite(x))
-        return usage_error(cmd, "%s: '%s' is not a finite number", what, text);
-    *out = x;
-    return EXIT_OK;
-}
-
 static int parse_integer(const char *cmd, const char *what, const char *text,
                          long long lo, long long hi, long long *out)
 {
@@ -342,133 +303,38 @@ static int parse_integer(const char *cmd, const char *what, const char *text,
     return EXIT_OK;
 }
 
-/* A run option's name on the command line: '_' as '-', "no-" first when
- * negated. */
-static void run_option_name(char *out, const tk_field *f, bool negated)
-{
-    snprintf(out, NAME_SIZE, "%s%s", negated ? "no-" : "", f->name);
-    for (char *p = out; *p; p++)
-        if (*p == '_')
-            *p = '-';
-}
-
-/* Sets run option k from --NAME VALUE (or --NAME, --no-NAME for a BOOL). */
-static int apply_run_option(const char *cmd, cli_args *a, int code, const char *value)
-{
-    const tk_field *f = &tk_option_fields[(code - OPT_RUN) / 2];
-    tk_error err;
-    int rc = f->kind == TK_KIND_BOOL ? tk_field_set(f, &a->run, !((code - OPT_RUN) % 2), &err)
-                                     : tk_field_parse(f, &a->run, value, &err);
-    if (rc == TK_OK)
-        return EXIT_OK;
-    /* "option 'steps': ..." reads "--steps: ..." on a command line */
-    char name[NAME_SIZE];
-    run_option_name(name, f, false);
-    const char *why = strstr(err.message, "': ");
-    return usage_error(cmd, "--%s: %s", name, why ? why + 3 : err.message);
-}
-
-/* Sets one of the command line's own options from its text value. */
-static int apply_option(const char *cmd, int code, const char *value, cli_args *a)
-{
-    long long n = 0;
-    switch (code) {
-    case OPT_HELP: a->help = true; return EXIT_OK;
-    case OPT_JSON: a->json = true; return EXIT_OK;
-    case OPT_TOLERANCE:
-        if (parse_real(cmd, "--tolerance", value, &a->tolerance))
-            return EXIT_USAGE;
-        return a->tolerance < 0.0 ? usage_error(cmd, "--tolerance: '%s' is negative", value)
-                                  : EXIT_OK;
-    case OPT_VERTICES:
-        if (parse_integer(cmd, "--vertices", value, 1, LLONG_MAX, &n))
-            return EXIT_USAGE;
-        a->vertices = (unsigned long long)n > SIZE_MAX ? SIZE_MAX : (size_t)n;
-        return EXIT_OK;
-    case OPT_EVERY:
-        if (parse_integer(cmd, "--every", value, 1, LONG_MAX, &n))
-            return EXIT_USAGE;
-        a->every = (size_t)n;
-        return EXIT_OK;
-    case OPT_DISGUISE:
-        if (parse_integer(cmd, "--disguise", value, 0, LLONG_MAX, &n))
-            return EXIT_USAGE;
-        a->disguise = true;
-        a->seed = (unsigned long long)n;
-        return EXIT_OK;
-    case OPT_OUTPUT: a->output = value; return EXIT_OK;
-    case OPT_STRUTS_OUT: a->struts_out = value; return EXIT_OK;
-    case OPT_LOG: a->log_out = value; return EXIT_OK;
-    case OPT_SNAPSHOTS: a->snapshots = value; return EXIT_OK;
-    default: return apply_run_option(cmd, a, code, value);
-    }
-}
-
 /* Parses argv[0..argc) of a subcommand (argv[0] is the first argument
- * after its name) with getopt_long, accepting the options of `cmds` (one
- * CMD_ bit).  The other arguments are gathered, in order, at a->pos. */
-static int parse_args(const char *cmd, int argc, char **argv, unsigned cmds, cli_args *a)
+ * after its name), accepting the options of `cmd` (one CMD_ bit).  The
+ * other arguments are gathered, in order, at a->pos.  The help texts
+ * above describe these options; tighten's run options are listed from
+ * their table. */
+static int parse_args(const char *name, int argc, char **argv, unsigned cmd, cli_args *a)
 {
-    memset(a, 0, sizeof *a);
-    a->tolerance = DEFAULT_TOLERANCE;
-    a->run = (tk_options)TK_OPTIONS_INIT;
-    a->every = 100;
-    struct option longs[NOWN + 2 * 32 + 1];
-    char shorts[8] = "+:h";
-    size_t n = 0;
-    for (size_t k = 0; k < NOWN; k++)
-        if (own_options[k].cmds & cmds)
-            longs[n++] = own_options[k].o;
-    if (cmds & CMD_TIGHTEN) {
-        strcat(shorts, "o:");
-        for (size_t k = 0; k < tk_option_nfields && k < 32; k++) {
-            const tk_field *f = &tk_option_fields[k];
-            for (int neg = 0; f->name && neg <= (f->kind == TK_KIND_BOOL); neg++) {
-                run_option_name(a->names[2 * k + neg], f, neg);
-                longs[n++] = (struct option){a->names[2 * k + neg],
-                                             f->kind == TK_KIND_BOOL ? no_argument
-                                                                     : required_argument,
-                                             NULL, OPT_RUN + 2 * (int)k + neg};
-            }
-        }
+    *a = (cli_args){.run = TK_OPTIONS_INIT};
+    tk_cli_defaults(own_fields, sizeof own_fields / sizeof own_fields[0], a);
+    tk_cli c = {.n = 0};
+    tk_cli_flag(&c, "help", 'h', &a->help, NULL);
+    if (cmd != CMD_GENERATE)
+        tk_cli_flag(&c, "json", 0, &a->json, NULL);
+    if (cmd & (CMD_INFO | CMD_STRUTS))
+        tk_cli_fields(&c, &own_fields[OWN_TOLERANCE], 1, a);
+    if (cmd & CMD_GENERATE) {
+        tk_cli_fields(&c, &own_fields[OWN_VERTICES], 1, a);
+        tk_cli_text(&c, "disguise", 0, "SEED", &a->disguise, NULL);
     }
-    longs[n] = (struct option){0};
-    /* getopt_long reads from argv[1]; "+" keeps it from permuting, so the
-     * arguments are gathered here and options may follow them */
-    char **args = argv - 1;
-    int nargs = argc + 1;
-    optind = 0; /* glibc: start afresh */
-    opterr = 0;
-    for (;;) {
-        int before = optind > 0 ? optind : 1;
-        if (before >= nargs)
-            break;
-        /* a negative number is an argument ("torus -2 3" then fails on
-         * its value, not as an unknown option) */
-        const char *next = args[before];
-        if (next[0] == '-' && (isdigit((unsigned char)next[1]) || next[1] == '.')) {
-            argv[a->npos++] = args[before];
-            optind = before + 1;
-            continue;
-        }
-        int code = getopt_long(nargs, args, shorts, longs, NULL);
-        if (code == -1 && optind == before + 1 && !strcmp(args[before], "--")) {
-            /* "--": everything after it is an argument */
-            while (optind < nargs)
-                argv[a->npos++] = args[optind++];
-            break;
-        }
-        if (code == -1) {
-            argv[a->npos++] = args[optind++];
-            continue;
-        }
-        if (code == '?')
-            return usage_error(cmd, "unknown option '%s'", args[optind - 1]);
-        if (code == ':')
-            return usage_error(cmd, "option %s needs a value", args[optind - 1]);
-        if (apply_option(cmd, code, optarg, a))
-            return EXIT_USAGE;
+    if (cmd & CMD_TIGHTEN) {
+        tk_cli_text(&c, "output", 'o', "OUT", &a->output, NULL);
+        tk_cli_text(&c, "struts", 0, "OUT", &a->struts_out, NULL);
+        tk_cli_text(&c, "log", 0, "OUT", &a->log_out, NULL);
+        tk_cli_text(&c, "snapshots", 0, "DIR", &a->snapshots, NULL);
+        tk_cli_fields(&c, &own_fields[OWN_EVERY], 1, a);
+        tk_cli_fields(&c, tk_option_fields, tk_option_nfields, &a->run);
     }
+    tk_error err;
+    if (tk_cli_parse(&c, argc, argv, &a->npos, &err))
+        return usage_error(name, "%s", err.message);
+    if (a->disguise && tk_field_parse(&own_fields[OWN_SEED], a, a->disguise, &err))
+        return usage_error(name, "--disguise: '%s' is not an integer from 0 to 2^53", a->disguise);
     a->pos = argv;
     return EXIT_OK;
 }
@@ -476,41 +342,10 @@ static int parse_args(const char *cmd, int argc, char **argv, unsigned cmds, cli
 /* The named run options, as tighten's --help lists them. */
 static void print_run_options(FILE *out)
 {
-    for (size_t k = 0; k < tk_option_nfields; k++) {
-        const tk_field *f = &tk_option_fields[k];
-        if (!f->name)
-            continue;
-        char name[NAME_SIZE], flag[2 * NAME_SIZE + 8];
-        run_option_name(name, f, false);
-        if (f->kind == TK_KIND_BOOL)
-            snprintf(flag, sizeof flag, "--%s, --no-%s", name, name);
-        else
-            snprintf(flag, sizeof flag, "--%s X", name);
-        char dflt[48];
-        if (f->kind == TK_KIND_BOOL)
-            snprintf(dflt, sizeof dflt, "%s", f->dflt != 0.0 ? "on" : "off");
-        else
-            snprintf(dflt, sizeof dflt, "%g", f->dflt);
-        /* the help wrapped at 76 columns, under the flag */
-        fprintf(out, "  %s\n", flag);
-        char text[1024];
-        snprintf(text, sizeof text, "%s (default %s)", f->help, dflt);
-        const char *p = text;
-        while (*p) {
-            size_t len = strlen(p), cut = len;
-            if (len > 68) {
-                cut = 68;
-                while (cut > 0 && p[cut] != ' ')
-                    cut--;
-                if (cut == 0)
-                    cut = 68;
-            }
-            fprintf(out, "        %.*s\n", (int)cut, p);
-            p += cut;
-            while (*p == ' ')
-                p++;
-        }
-    }
+    tk_options run = TK_OPTIONS_INIT;
+    tk_cli c = {.n = 0};
+    tk_cli_fields(&c, tk_option_fields, tk_option_nfields, &run);
+    tk_cli_help(&c, out);
 }
 
 /* ---------------------------------------------------------------- output */

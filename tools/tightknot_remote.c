@@ -25,7 +25,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "tk/record.h"
+#include "cli.h"
+#include "jobopts.h"
 
 enum { REMOTE_OK = 0, REMOTE_USAGE = 1, REMOTE_FAILED = 2, REMOTE_SERVER = 3 };
 
@@ -543,10 +544,15 @@ static int submit_one(client *c, item *it, const char *query, double *retry)
 /* The query string of the run options given on the command line. */
 typedef struct run_args {
     char query[1024];
-    char out[4096];
-    long parallel;
+    const char *out;
+    size_t parallel;
     double poll;
 } run_args;
+
+static const tk_field run_arg_fields[] = {
+    TK_FIELD_ROW(run_args, parallel, parallel, SIZE, 4, 1, 1000, "parallel", ""),
+    TK_FIELD_ROW(run_args, poll, poll, REAL, 1, 1e-3, 3600, "poll", ""),
+};
 
 static void progress_line(client *c, const item *items, size_t n, const char *last)
 {
@@ -846,114 +852,42 @@ int tk_remote_main(int argc, char **argv)
     const char *server = getenv("TIGHTKNOT_SERVER");
     if (!server || !*server)
         server = "http://127.0.0.1:8080";
-    run_args a;
-    memset(&a, 0, sizeof a);
-    snprintf(a.out, sizeof a.out, "tightknot-results");
-    a.parallel = 4;
-    a.poll = 1.0;
-    bool json = false;
-    tk_options run = TK_OPTIONS_INIT; /* the job's run options */
-    long every = 0;                   /* its frames */
-    const char *command = NULL;
-    char **rest = calloc((size_t)argc + 1, sizeof *rest);
-    int nrest = 0;
-    if (!rest)
-        return REMOTE_FAILED;
-    int status = REMOTE_OK;
-    for (int i = 0; i < argc && status == REMOTE_OK; i++) {
-        const char *arg = argv[i];
-        bool has_value = i + 1 < argc;
-        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
-            fputs(tk_remote_help, stdout);
-            free(rest);
-            return REMOTE_OK;
-        }
-        if (!strcmp(arg, "--")) {
-            while (++i < argc)
-                rest[nrest++] = argv[i];
-            break;
-        }
-        if (strncmp(arg, "--", 2) != 0) {
-            if (!command)
-                command = arg;
-            else
-                rest[nrest++] = argv[i];
-            continue;
-        }
-        const char *name = arg + 2;
-        /* a run option (tk/record.h): --name, '_' written '-'; a BOOL as
-         * --name or --no-name */
-        char field_name[64];
-        snprintf(field_name, sizeof field_name, "%s", name);
-        for (char *p = field_name; *p; p++)
-            *p = *p == '-' ? '_' : *p;
-        bool negated = !strncmp(field_name, "no_", 3);
-        const tk_field *f = tk_field_find(tk_option_fields, tk_option_nfields,
-                                          negated ? field_name + 3 : field_name);
-        if (f && negated && f->kind != TK_KIND_BOOL)
-            f = NULL;
-        tk_error err;
-        if (!strcmp(name, "json")) {
-            json = true;
-        } else if (f && f->kind == TK_KIND_BOOL) {
-            tk_field_set(f, &run, !negated, NULL);
-        } else if (!has_value) {
-            fprintf(stderr, "tightknot remote: %s needs a value\n", arg);
-            status = REMOTE_USAGE;
-        } else if (!strcmp(name, "server")) {
-            server = argv[++i];
-        } else if (!strcmp(name, "out")) {
-            snprintf(a.out, sizeof a.out, "%s", argv[++i]);
-        } else if (!strcmp(name, "parallel") || !strcmp(name, "poll")) {
-            char *end = NULL;
-            double x = strtod(argv[++i], &end);
-            bool parallel = !strcmp(name, "parallel");
-            if (end == argv[i] || *end || !(x > 0) || (parallel && (x != floor(x) || x > 1000)) ||
-                x > 3600) {
-                fprintf(stderr, "tightknot remote: %s: '%s' must be %s\n", arg, argv[i],
-                        parallel ? "a whole number from 1 to 1000" : "positive seconds");
-                status = REMOTE_USAGE;
-            } else if (parallel) {
-                a.parallel = (long)x;
-            } else {
-                a.poll = x;
-            }
-        } else if (f) {
-            if (tk_field_parse(f, &run, argv[++i], &err) != TK_OK) {
-                fprintf(stderr, "tightknot remote: %s\n", err.message);
-                status = REMOTE_USAGE;
-            }
-        } else if (!strcmp(name, "every")) {
-            char *end = NULL;
-            errno = 0;
-            long long n = strtoll(argv[++i], &end, 10);
-            if (end == argv[i] || *end || errno || n < 0 || n > 100000000) {
-                fprintf(stderr, "tightknot remote: --every: '%s' must be a whole number from 0 "
-                                "to 100000000\n", argv[i]);
-                status = REMOTE_USAGE;
-            }
-            every = (long)n;
-        } else {
-            fprintf(stderr, "tightknot remote: unknown option '%s'\n", arg);
-            status = REMOTE_USAGE;
-        }
+    run_args a = {.out = "tightknot-results"};
+    tk_cli_defaults(run_arg_fields, 2, &a);
+    bool json = false, help = false;
+    tk_job_options job = TK_JOB_OPTIONS_INIT;
+    tk_cli cli = {.n = 0};
+    tk_cli_flag(&cli, "help", 'h', &help, NULL);
+    tk_cli_flag(&cli, "json", 0, &json, NULL);
+    tk_cli_text(&cli, "server", 0, "URL", &server, NULL);
+    tk_cli_text(&cli, "out", 0, "DIR", &a.out, NULL);
+    tk_cli_fields(&cli, run_arg_fields, 2, &a);
+    tk_cli_fields(&cli, tk_job_option_fields, tk_job_option_nfields, &job);
+    tk_error err;
+    int npos = 0;
+    if (tk_cli_parse(&cli, argc, argv, &npos, &err)) {
+        fprintf(stderr, "tightknot remote: %s\nTry 'tightknot remote --help'.\n", err.message);
+        return REMOTE_USAGE;
     }
-    if (status == REMOTE_OK && !command) {
-        fprintf(stderr, "tightknot remote: no COMMAND given (submit, status, cancel, delete or fetch)\n");
-        status = REMOTE_USAGE;
+    if (help) {
+        fputs(tk_remote_help, stdout);
+        return REMOTE_OK;
     }
-    if (status != REMOTE_OK) {
-        fprintf(stderr, "Try 'tightknot remote --help'.\n");
-        free(rest);
-        return status;
+    if (npos == 0) {
+        fprintf(stderr, "tightknot remote: no COMMAND given (submit, status, cancel, delete or "
+                        "fetch)\nTry 'tightknot remote --help'.\n");
+        return REMOTE_USAGE;
     }
+    const char *command = argv[0];
+    char **rest = argv + 1;
+    int nrest = npos - 1, status = REMOTE_OK;
     /* the options as a query string, only those that differ from the
      * defaults, so the server's defaults stay the server's */
-    tk_options defaults = TK_OPTIONS_INIT;
+    tk_job_options defaults = TK_JOB_OPTIONS_INIT;
     size_t q = 0;
-    for (size_t k = 0; k < tk_option_nfields; k++) {
-        const tk_field *f = &tk_option_fields[k];
-        double x = tk_field_get(f, &run);
+    for (size_t k = 0; k < tk_job_option_nfields; k++) {
+        const tk_field *f = &tk_job_option_fields[k];
+        double x = tk_field_get(f, &job);
         if (f->name && x != tk_field_get(f, &defaults) && q < sizeof a.query)
             q += (size_t)(f->kind == TK_KIND_BOOL
                               ? snprintf(a.query + q, sizeof a.query - q, "&%s=%s", f->name,
@@ -961,8 +895,6 @@ int tk_remote_main(int argc, char **argv)
                               : snprintf(a.query + q, sizeof a.query - q, "&%s=%.17g",
                                          f->name, x));
     }
-    if (every > 0 && q < sizeof a.query)
-        snprintf(a.query + q, sizeof a.query - q, "&every=%ld", every);
 
     client c;
     memset(&c, 0, sizeof c);
@@ -972,14 +904,12 @@ int tk_remote_main(int argc, char **argv)
     if (strncmp(server, "http://", 7) && strncmp(server, "https://", 8)) {
         fprintf(stderr, "tightknot remote: --server: '%s' is not an http:// or https:// URL\n",
                 server);
-        free(rest);
         return REMOTE_USAGE;
     }
     snprintf(c.base, sizeof c.base, "%.*s", (int)blen, server);
     c.tty = isatty(STDERR_FILENO) != 0;
     if (curl_global_init(CURL_GLOBAL_DEFAULT) != CURLE_OK || !(c.curl = curl_easy_init())) {
         fprintf(stderr, "tightknot remote: cannot start libcurl\n");
-        free(rest);
         return REMOTE_FAILED;
     }
     if (!strcmp(command, "submit"))
@@ -995,6 +925,5 @@ int tk_remote_main(int argc, char **argv)
     }
     curl_easy_cleanup(c.curl);
     curl_global_cleanup();
-    free(rest);
     return status;
 }
