@@ -89,21 +89,14 @@ __attribute__((format(printf, 6, 7))) static result
 problem(tk_api *a, conn *c, unsigned status, json_t *extra, const char *const *headers,
         const char *fmt, ...)
 {
-    static const char *const titles[][2] = {
-        {"400", "Bad Request"}, {"404", "Not Found"}, {"405", "Method Not Allowed"},
-        {"413", "Content Too Large"}, {"415", "Unsupported Media Type"},
-        {"422", "Unprocessable Content"}, {"429", "Too Many Requests"},
-        {"500", "Internal Server Error"}, {"503", "Service Unavailable"}};
-    char code[8], detail[1024];
-    snprintf(code, sizeof code, "%u", status);
-    const char *title = "Error";
-    for (size_t i = 0; i < sizeof titles / sizeof titles[0]; i++)
-        title = strcmp(titles[i][0], code) ? title : titles[i][1];
+    char detail[1024];
+    const char *title = MHD_get_reason_phrase_for(status);
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(detail, sizeof detail, fmt, ap);
     va_end(ap);
-    json_t *o = json_pack("{s:s, s:s, s:i, s:o}", "type", "about:blank", "title", title, "status",
+    json_t *o = json_pack("{s:s, s:s, s:i, s:o}", "type", "about:blank", "title",
+                          title[0] ? title : "Error", "status",
                           (int)status, "detail", tk_json_text(detail));
     json_object_update(o, extra);
     json_decref(extra);
