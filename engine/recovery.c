@@ -25,15 +25,19 @@ void tk_recovery_free(tk_run *r)
     free(r->recovery.rhs);
     free(r->recovery.du);
     free(r->recovery.before);
+    free(r->recovery.checked);
 }
 
 int tk_recovery_fit(tk_run *r, size_t vertices, tk_error *err)
 {
     free(r->recovery.du);
     free(r->recovery.before);
+    free(r->recovery.checked);
     r->recovery.du = calloc(3 * vertices, sizeof *r->recovery.du);
     r->recovery.before = calloc(3 * vertices, sizeof *r->recovery.before);
-    if (!r->recovery.du || !r->recovery.before)
+    r->recovery.checked = calloc(3 * vertices, sizeof *r->recovery.checked);
+    r->recovery.checked_vertices = 0;
+    if (!r->recovery.du || !r->recovery.before || !r->recovery.checked)
         return tk_error_set(err, TK_ENOMEM, "out of memory for a run of %zu vertices", vertices);
     return TK_OK;
 }
@@ -43,12 +47,25 @@ int tk_recovery_fit(tk_run *r, size_t vertices, tk_error *err)
 int tk_recovery_violation(tk_run *r, const tk_curve *c, double *out, tk_error *err)
 {
     double t0 = tk_clock(), closest;
+    size_t n3 = 3 * c->nvert;
+    /* the last curve checked: its answer (a function of the curve alone) */
+    if (r->recovery.checked_vertices == c->nvert &&
+        !memcmp(r->recovery.checked, c->xyz, n3 * sizeof *c->xyz)) {
+        *out = r->recovery.checked_worst;
+        r->recovery.check_seconds += tk_clock() - t0;
+        return TK_OK;
+    }
     int rc = tk_strut_finder_closest_pair(r->shared.finder, c, TK_ARC_ADMISSIBLE, r->tau, r->tau,
                                           &closest, err);
     if (!rc) {
         double minrad = tk_curve_minrad(c, NULL);
         double v = fmax((r->tau - closest) / r->tau, (r->min_radius - minrad) / r->min_radius);
         *out = fmax(v, 0.0);
+        if (r->recovery.checked) {
+            memcpy(r->recovery.checked, c->xyz, n3 * sizeof *c->xyz);
+            r->recovery.checked_vertices = c->nvert;
+            r->recovery.checked_worst = *out;
+        }
     }
     r->recovery.check_seconds += tk_clock() - t0;
     return rc;

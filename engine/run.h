@@ -109,6 +109,9 @@ struct tk_run {
         size_t rhs_capacity;
         double *du;      /* 3V: a Newton step */
         double *before;  /* 3V: the curve before this step, to undo it */
+        double *checked; /* 3V: the curve last checked, and what it gave */
+        size_t checked_vertices; /* 0: none */
+        double checked_worst;
         double seconds, nnls_seconds, check_seconds;
         long rescales, undone;
         double largest_rescale; /* scale factor - 1 */
@@ -258,7 +261,9 @@ void tk_stepping_reset(tk_run *r);
 /* ---- recovery.c ---- */
 
 /* Worst violation of the constraints by c as a fraction of the bound (0
- * when all hold); the finder must be fitted to c. */
+ * when all hold); the finder must be fitted to c.  The curve a step
+ * accepts is the last trial it checked, and the step's figures check it
+ * again: a curve equal to the last one checked is not searched twice. */
 int tk_recovery_violation(tk_run *r, const tk_curve *c, double *out, tk_error *err);
 /* Corrects the run's curve until no constraint is violated beyond the
  * correction tolerance (section 4.6); the finder is then fitted to it.
