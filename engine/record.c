@@ -104,6 +104,9 @@ int tk_options_check(const tk_options *o, tk_error *err)
         if (rc)
             return rc;
     }
+    if (o->vertices > 0 && o->resolution > 0.0)
+        return tk_error_set(err, TK_EINVAL,
+                            "vertices and resolution both set the vertex count: give one");
     if (o->re_resolve > 0.0 && o->snapshot_every > 0)
         return tk_error_set(err, TK_EINVAL,
                             "re_resolve changes the vertex count, which snapshots keep: "

@@ -96,10 +96,22 @@ static int measure(const tk_curve *c, tk_measure *m, tk_error *err)
     return rc;
 }
 
-/* The resolution of the current coarse level (the option's at the last). */
-static double resolution_now(const tk_run *r)
+/* The resolution of the final polygon: the option's, or the vertices
+ * asked for per unit of the start's ropelength (0: the input's polygon). */
+static double resolution_final(const tk_run *r)
 {
-    return ldexp(r->opt.resolution, -r->schedule.coarse_level);
+    return r->opt.vertices > 0 ? (double)r->opt.vertices / r->schedule.start_ropelength
+                               : r->opt.resolution;
+}
+
+/* The vertices of the current coarse level at ropelength rope: with the
+ * vertices option, exactly that count at the last level. */
+static size_t level_count(const tk_run *r, double rope)
+{
+    int level = r->schedule.coarse_level;
+    if (r->opt.vertices > 0)
+        return (size_t)ceil(ldexp((double)r->opt.vertices, -level));
+    return (size_t)ceil(ldexp(r->opt.resolution, -level) * rope);
 }
 
 bool tk_schedule_final(const tk_run *r)
@@ -137,13 +149,16 @@ int tk_schedule_fit(tk_run *r, tk_error *err)
     return TK_OK;
 }
 
-/* The levels a run with these options starts with (prepare_curve). */
-static int coarse_levels(const tk_options *o)
+/* The levels a run starts with (prepare_curve); the start's ropelength
+ * is known. */
+static int coarse_levels(const tk_run *r)
 {
+    const tk_options *o = &r->opt;
+    double resolution = resolution_final(r);
     int level = 0;
-    if (o->resolution > 0.0 && o->coarse_to_fine && o->snapshot_every == 0)
+    if (resolution > 0.0 && o->coarse_to_fine && o->snapshot_every == 0)
         while (level < MAX_COARSE_LEVELS &&
-               ldexp(o->resolution, -(level + 1)) >= COARSEST_RESOLUTION)
+               ldexp(resolution, -(level + 1)) >= COARSEST_RESOLUTION)
             level++;
     return level;
 }
@@ -170,17 +185,16 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
                             "the curve is too thin for its length to tighten in double "
                             "precision: ropelength %.6g, above %g (does it nearly cross itself?)",
                             m.ropelength, START_ROPELENGTH_MAX);
-    if (r->opt.resolution > 0.0) {
-        double want = ceil(r->opt.resolution * m.ropelength);
+    if (resolution_final(r) > 0.0) {
+        double want = (double)level_count(r, m.ropelength);
         if (want > TK_RUN_MAX_VERTICES)
             return tk_error_set(err, TK_ELIMIT,
                                 "resolution %g at ropelength %.4g asks for %.0f vertices: a "
                                 "run holds at most %d (about 2 GiB of memory)",
                                 r->opt.resolution, m.ropelength, want, TK_RUN_MAX_VERTICES);
-        r->schedule.coarse_level = r->schedule.coarse_levels = coarse_levels(&r->opt);
-        want = ceil(resolution_now(r) * m.ropelength);
+        r->schedule.coarse_level = r->schedule.coarse_levels = coarse_levels(r);
         tk_curve *resampled = NULL;
-        rc = tk_curve_resample_total(*curve, (size_t)want, &resampled, err);
+        rc = tk_curve_resample_total(*curve, level_count(r, m.ropelength), &resampled, err);
         if (rc)
             return rc;
         tk_curve_free(curve);
@@ -192,7 +206,7 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
                                 "(nearly) cross itself (ropelength %.6g, from %.6g): the smooth "
                                 "curve through the vertices loops where they turn sharply; "
                                 "tighten without a resolution first, or add vertices there",
-                                (*curve)->nvert, r->opt.resolution, rc ? INFINITY : m.ropelength,
+                                (*curve)->nvert, resolution_final(r), rc ? INFINITY : m.ropelength,
                                 r->schedule.start_ropelength);
         if (rc)
             return rc;
@@ -227,7 +241,8 @@ int tk_schedule_start(tk_run *r, const tk_curve *start, tk_error *err)
 
 int tk_schedule_resume(tk_run *r, const tk_curve *curve, const tk_resume *at, tk_error *err)
 {
-    r->schedule.coarse_levels = coarse_levels(&r->opt);
+    r->schedule.start_ropelength = at->start_ropelength;
+    r->schedule.coarse_levels = coarse_levels(r);
     if (at->coarse_level > r->schedule.coarse_levels)
         return tk_error_set(err, TK_EINVAL,
                             "the run resumes at coarse level %d, but its options have %d",
@@ -235,7 +250,6 @@ int tk_schedule_resume(tk_run *r, const tk_curve *curve, const tk_resume *at, tk
     r->schedule.coarse_level = at->coarse_level;
     r->schedule.polish_level = at->polish_level;
     r->schedule.share_from = at->share_from;
-    r->schedule.start_ropelength = at->start_ropelength;
     r->schedule.resolved_at = at->resolved_at > 0.0 ? at->resolved_at : INFINITY;
     tk_measure m;
     int rc = tk_curve_copy(curve, &r->shared.curve, err);
@@ -324,7 +338,7 @@ static int refine(tk_run *r, tk_error *err)
     r->schedule.coarse_level--;
     double rope =
         r->opt.re_resolve > 0.0 ? r->life.latest.ropelength : r->schedule.start_ropelength;
-    return resample_to(r, (size_t)ceil(resolution_now(r) * rope), err);
+    return resample_to(r, level_count(r, rope), err);
 }
 
 /* A run with a budget of steps or time spends its last share of it on the
@@ -366,7 +380,7 @@ int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_
         r->schedule.coarse_level = r->schedule.coarse_levels;
         double rope = r->opt.re_resolve > 0.0 ? r->life.latest.ropelength
                                               : r->schedule.start_ropelength;
-        count = (size_t)ceil(resolution_now(r) * rope);
+        count = level_count(r, rope);
     }
     tk_measure m;
     int rc = measure(curve, &m, err);
@@ -411,7 +425,7 @@ int tk_schedule_before_step(tk_run *r, tk_error *err)
         r->schedule.resolved_at = rope;
         return TK_OK;
     }
-    double want = ceil(resolution_now(r) * rope);
+    double want = (double)level_count(r, rope);
     if (!(rope < r->schedule.resolved_at * (1.0 - o->re_resolve)) ||
         !(want < (double)r->shared.curve->nvert * (1.0 - o->re_resolve)))
         return TK_OK;

@@ -184,9 +184,11 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
         char when[64];
         if (at)
             snprintf(when, sizeof when, "the curve resumed at step %ld", at->step);
-        else
+        else if (r->opt.resolution > 0.0)
             snprintf(when, sizeof when, "resampling to %zu vertices (resolution %g)",
                      r->shared.curve->nvert, r->opt.resolution);
+        else
+            snprintf(when, sizeof when, "resampling to %zu vertices", r->shared.curve->nvert);
         rc = tk_type_check(r, when, err);
     }
     tk_step_report rep = {0};

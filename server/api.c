@@ -279,6 +279,10 @@ static result post_job(tk_api *a, conn *c, const request *rq)
         ret = input_problem(a, c, &err);
     } else if (tk_options_check(&sub.options.run, &err)) {
         ret = input_problem(a, c, &err);
+    } else if (sub.options.run.vertices > a->cfg.max_vertices) {
+        ret = problem(a, c, 422, json_pack("{s:s}", "option", "vertices"), NULL, "option "
+                      "'vertices': %zu vertices; the limit is %zu", sub.options.run.vertices,
+                      a->cfg.max_vertices);
     } else {
         /* the reader refuses a NUL anywhere: the text is a C string */
         json_t *doc = tk_job_new(sub.name, &sub.options, curve->ncomp, curve->nvert);

@@ -17,8 +17,8 @@ trap 'exit 1' INT TERM
 check() { # check STATUS WHAT
     if [ "$1" -eq 0 ]; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL $2"; fi
 }
-value() { # value NAME FILE: a number or string of a one-line JSON object
-    sed -n "s/.*\"$1\":\"*\([^,}\"]*\).*/\1/p" "$2" | head -n 1
+value() { # value NAME FILE: a number or string of a one-line JSON object (the first NAME)
+    grep -o "\"$1\":\"*[^,}\"]*" "$2" | head -n 1 | sed 's/^[^:]*:"*//'
 }
 close() { # close A B RELTOL: |A - B| <= RELTOL * |B|
     awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; m = b < 0 ? -b : b;

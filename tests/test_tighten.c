@@ -189,6 +189,44 @@ START_TEST(re_resolution_keeps_the_resolution)
 }
 END_TEST
 
+START_TEST(vertices_option_ends_at_exactly_that_count)
+{
+    /* The vertices option asks for a count, not a density: the run goes
+     * coarse to fine as with the resolution it implies (the count over the
+     * start's ropelength), each level ceil(count / 2^k), and ends on a
+     * polygon of exactly that many vertices, resumed or not; with a
+     * resolution too it is refused. */
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_figure_eight(0, &c, NULL), TK_OK);
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.vertices = 4 * (size_t)ceil(2.5 * m.ropelength) + 3; /* two levels, odd */
+    o.escapes = 0;
+    o.max_steps = quick() ? 120 : 900;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, (o.vertices + 3) / 4);
+    tk_stop_reason why;
+    const tk_step_report *last = run_watched(run, &o, "figure-eight to a vertex count", &why);
+    size_t nh = 0;
+    const tk_step_report *h = tk_run_history(run, &nh);
+    for (size_t i = 0; i < nh; i++)
+        ck_assert_msg(h[i].vertices == (o.vertices + 3) / 4 || h[i].vertices == (o.vertices + 1) / 2
+                      || h[i].vertices == o.vertices, "step %ld: %zu vertices", h[i].step,
+                      h[i].vertices);
+    ck_assert_uint_eq(last->vertices, o.vertices);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, o.vertices);
+    tk_run_free(&run);
+    o.resolution = 5;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_EINVAL);
+    ck_assert_msg(strstr(err.message, "vertices and resolution"), "%s", err.message);
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(coarse_to_fine_ends_at_the_resolution)
 {
     /* With a resolution the run starts on a polygon of half the vertices
@@ -1033,6 +1071,7 @@ int main(void)
     tcase_add_test(tc, a_resumed_run_keeps_its_escapes);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
+    tcase_add_test(tc, vertices_option_ends_at_exactly_that_count);
     tcase_add_test(tc, cancellation_stops_within_one_step);
     tcase_add_test(tc, parallel_runs_equal_serial_runs);
     tcase_add_test(tc, round_hopf_start_with_continuum_of_contacts);

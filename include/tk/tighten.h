@@ -72,6 +72,10 @@
     X(resolution, REAL, 0.0, 0.0, 1e4, "resolution",                                         \
       "resample the start to resolution x ropelength vertices (5 quick, 10 medium, 20 "      \
       "fine); 0 keeps the input's")                                                          \
+    X(vertices, SIZE, 0, 0, 1e6, "vertices",                                                 \
+      "resample the start to this many vertices in all (coarse to fine as with a "          \
+      "resolution), to compare with tables at a given vertex count (0: not; not with a "     \
+      "resolution)")                                                                         \
     X(autoscale, BOOL, false, 0, 1, "autoscale",                                             \
       "first scale the start so that its thickness is just above the diameter (needed "      \
       "when it is thinner)")                                                                 \

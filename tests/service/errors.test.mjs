@@ -261,6 +261,8 @@ describe('bad JSON, bad options, wrong media type', () => {
             [{ resolution: 1e6 }, 'resolution'],
             [{ autoscale: 'yes' }, 'autoscale'],
             [{ every: 1e10 }, 'every'],
+            [{ vertices: 2.5 }, 'vertices'],
+            [{ vertices: 200001 }, 'vertices'], // beyond the daemon's --max-vertices
         ];
         for (const [options, option] of cases) {
             const r = await d.post('/v1/jobs', { catalogue: '3.1', options });
