@@ -9,8 +9,13 @@
  * found different critical configurations: at most one is tight.
  * Prints figures; never fails on time.
  *
+ * With --atlas each start is tightened instead to the vertex count of the
+ * public atlas's polygon of its type (the vertices option) for S seconds
+ * (default 600), and judged against the atlas's value at that count:
+ * "within.1%" and "at.atlas" (at or below it).
+ *
  *   bench/starts [CATALOGUE_DIR] [--seconds S] [--resolution R] [--jobs N]
- *                [--list] [START ...]
+ *                [--atlas] [--list] [START ...]
  */
 #include <math.h>
 #include <pthread.h>
@@ -34,6 +39,15 @@
 #define ROPE_10_124 71.08937
 #define ROPE_HOPF 25.132741228718345 /* 8 pi */
 #define ROPE_CHAIN3 41.69911184307752 /* 12 pi + 4 */
+
+/* The atlas's polygons: vertex count and ropelength. */
+static const struct {
+    const char *type;
+    size_t vertices;
+    double ropelength;
+} atlas[] = {{"3_1", 2400, ROPE_3_1},   {"4_1", 400, ROPE_4_1},   {"5_1", 392, ROPE_5_1},
+             {"6_1", 480, ROPE_6_1},    {"8_19", 489, ROPE_8_19}, {"10_124", 576, ROPE_10_124},
+             {"Hopf", 202, 25.14142}};
 
 typedef enum maker { FILE_START, TORUS, FIGURE_EIGHT, HOPF, CHAIN } maker;
 
@@ -110,6 +124,7 @@ static tk_curve *make_start(const start *s, const char *dir, tk_error *err)
 typedef struct bench {
     const char *dir;
     double seconds, resolution;
+    bool atlas;
     const start *todo[NSTARTS];
     size_t ntodo, next;
     pthread_mutex_t lock;
@@ -141,6 +156,24 @@ static void run_start(bench *b, const start *s)
     o.autoscale = true;
     o.resolution = b->resolution;
     o.max_seconds = b->seconds;
+    double best = s->best, margin[2] = {0.005, 0.001};
+    for (size_t k = 0; b->atlas && k < sizeof atlas / sizeof atlas[0]; k++)
+        if (!strcmp(atlas[k].type, s->type)) {
+            o.resolution = 0.0;
+            o.vertices = atlas[k].vertices;
+            best = atlas[k].ropelength;
+            margin[0] = 0.001;
+            margin[1] = 0.0;
+        }
+    if (b->atlas && o.vertices == 0) {
+        snprintf(line, sizeof line, "%-9s %-7s no atlas polygon of this type\n", s->name, s->type);
+        pthread_mutex_lock(&b->lock);
+        fputs(line, stdout);
+        fflush(stdout);
+        pthread_mutex_unlock(&b->lock);
+        tk_curve_free(&c);
+        return;
+    }
     tk_run *run = NULL;
     int rc = tk_run_new(c, &o, &run, &err);
     tk_stop_reason why = TK_STOP_NONE;
@@ -158,15 +191,15 @@ static void run_start(bench *b, const start *s)
             improved += e[k].improved;
         /* the crossings count on the final polygon, whose count the
          * best known value's excess is about */
-        double within[2] = {-1.0, -1.0}, margin[2] = {0.005, 0.001};
-        for (size_t i = 0; i < nh && isfinite(s->best); i++)
+        double within[2] = {-1.0, -1.0};
+        for (size_t i = 0; i < nh && isfinite(best); i++)
             for (int k = 0; k < 2; k++)
                 if (within[k] < 0.0 && h[i].vertices == last->vertices &&
-                    h[i].ropelength <= s->best * (1.0 + margin[k]))
+                    h[i].ropelength <= best * (1.0 + margin[k]))
                     within[k] = h[i].seconds;
         char excess[16] = "-", w5[16], w1[16];
-        if (isfinite(s->best))
-            snprintf(excess, sizeof excess, "%+.3f%%", 100.0 * (last->ropelength / s->best - 1.0));
+        if (isfinite(best))
+            snprintf(excess, sizeof excess, "%+.3f%%", 100.0 * (last->ropelength / best - 1.0));
         describe(w5, sizeof w5, within[0]);
         describe(w1, sizeof w1, within[1]);
         snprintf(line, sizeof line, "%-9s %-7s %8zu %8ld %11.5f %10s %9s %9s %5zu %5zu  %s%s%s\n",
@@ -197,17 +230,22 @@ static void *worker(void *arg)
 int main(int argc, char **argv)
 {
     bench b = {.dir = "../shared/catalogue", .seconds = 120.0, .resolution = 5.0};
+    bool seconds_given = false;
     long jobs = 2;
     pthread_mutex_init(&b.lock, NULL);
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             printf("usage: starts [CATALOGUE_DIR] [--seconds S] [--resolution R] [--jobs N]\n"
-                   "              [--list] [START ...]\n"
+                   "              [--atlas] [--list] [START ...]\n"
                    "Tightens each start (default: all; --list names them) at resolution R\n"
                    "(default 5) for S seconds (default 120), N at a time (default 2), and\n"
                    "prints its final ropelength, its excess over the best known value and\n"
-                   "when it came within 0.5%% and 0.1%% of it on its final polygon.\n");
+                   "when it came within 0.5%% and 0.1%% of it on its final polygon.\n"
+                   "--atlas: each at the atlas's vertex count of its type instead, for S\n"
+                   "seconds (default 600), against the atlas's value.\n");
             return 0;
+        } else if (strcmp(argv[i], "--atlas") == 0) {
+            b.atlas = true;
         } else if (strcmp(argv[i], "--list") == 0) {
             for (size_t k = 0; k < NSTARTS; k++)
                 printf("%-9s %-7s %s\n", starts[k].name, starts[k].type,
@@ -215,6 +253,7 @@ int main(int argc, char **argv)
             return 0;
         } else if (strcmp(argv[i], "--seconds") == 0 && i + 1 < argc) {
             b.seconds = strtod(argv[++i], NULL);
+            seconds_given = true;
         } else if (strcmp(argv[i], "--resolution") == 0 && i + 1 < argc) {
             b.resolution = strtod(argv[++i], NULL);
         } else if (strcmp(argv[i], "--jobs") == 0 && i + 1 < argc) {
@@ -237,11 +276,19 @@ int main(int argc, char **argv)
             b.todo[b.ntodo++] = &starts[k];
     if (jobs < 1 || jobs > 64)
         jobs = 1;
-    printf("starts at resolution %g, %.0f s each, %ld at a time; excess over the best known "
-           "value; within: first time on the final polygon\n\n",
-           b.resolution, b.seconds, jobs);
+    if (b.atlas && !seconds_given)
+        b.seconds = 600.0;
+    if (b.atlas)
+        printf("starts at the atlas's vertex counts, %.0f s each, %ld at a time; excess over "
+               "the atlas's value at that count; within: first time on the final polygon\n\n",
+               b.seconds, jobs);
+    else
+        printf("starts at resolution %g, %.0f s each, %ld at a time; excess over the best known "
+               "value; within: first time on the final polygon\n\n",
+               b.resolution, b.seconds, jobs);
     printf("%-9s %-7s %8s %8s %11s %10s %9s %9s %5s %5s  %s\n", "start", "type", "vertices",
-           "steps", "ropelength", "excess", "within.5%", "within.1%", "esc", "impr", "stop");
+           "steps", "ropelength", "excess", b.atlas ? "within.1%" : "within.5%",
+           b.atlas ? "at.atlas" : "within.1%", "esc", "impr", "stop");
     pthread_t th[64];
     for (long k = 0; k < jobs; k++)
         pthread_create(&th[k], NULL, worker, &b);
