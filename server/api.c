@@ -32,6 +32,7 @@ typedef struct entry {
 
 struct tk_api {
     tk_api_config cfg;
+    char *hosts; /* the hosts served, comma-separated (the browser boundary) */
     char *web;
     entry *entries; /* the catalogue, sorted by name */
     size_t nentries;
@@ -43,6 +44,54 @@ struct tk_api {
     atomic_ullong responses[4];   /* by class: 2xx .. 5xx */
     time_t started;
 };
+
+/* ---- the browser boundary ---- */
+
+/* Whether the comma-separated list holds item (len bytes), ignoring case. */
+static bool listed(const char *list, const char *item, size_t len)
+{
+    for (const char *p = list; p && *p; p += strcspn(p, ",") + (p[strcspn(p, ",")] == ',')) {
+        size_t n = strcspn(p, ",");
+        if (n == len && !strncasecmp(p, item, len))
+            return true;
+    }
+    return false;
+}
+
+/* An allowed other origin the request comes from, or NULL. */
+static const char *allowed_origin(const tk_api *a, conn *c)
+{
+    const char *origin = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Origin");
+    return origin && listed(a->cfg.allow_origins, origin, strlen(origin)) ? origin : NULL;
+}
+
+/* A page in a browser can send requests to any address, loopback too:
+ * with a name of its own that resolves here (DNS rebinding) it can even
+ * read the answers.  So the Host a request names must be one this daemon
+ * serves, and a request a page sends (it carries an Origin) must come from
+ * the daemon's own origin (the page it serves) or one allowed with
+ * --allow-origin.  0 when the request may pass, else the status to refuse
+ * it with (421 or 403), with why. */
+static unsigned boundary(const tk_api *a, conn *c, char *why, size_t size)
+{
+    const char *host = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);
+    const char *origin = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Origin");
+    if (host) { /* the name without its port; [v6] whole */
+        size_t n = host[0] == '[' ? strcspn(host, "]") + 1 : strcspn(host, ":");
+        if (!listed(a->hosts, host, n)) {
+            snprintf(why, size, "this server does not serve the host '%.*s' (it serves %s; "
+                     "name more with --host)", (int)(n < 200 ? n : 200), host, a->hosts);
+            return 421;
+        }
+    }
+    const char *authority = origin ? strstr(origin, "://") : NULL;
+    if (!origin || (authority && host && !strcasecmp(authority + 3, host)) ||
+        allowed_origin(a, c))
+        return 0;
+    snprintf(why, size, "requests from pages at '%.200s' are not allowed here (the daemon's "
+             "own page is; allow others with --allow-origin)", origin);
+    return 403;
+}
 
 /* A request's body as it arrives; cap bytes are counted in tk_api.held. */
 typedef struct request {
@@ -66,6 +115,11 @@ static result send_buffer(tk_api *a, conn *c, unsigned status, const char *type,
         MHD_add_response_header(r, MHD_HTTP_HEADER_CONTENT_TYPE, type);
     for (size_t i = 0; headers && headers[i]; i += 2)
         MHD_add_response_header(r, headers[i], headers[i + 1]);
+    const char *origin = allowed_origin(a, c); /* CORS: that page may read it */
+    if (origin) {
+        MHD_add_response_header(r, "Access-Control-Allow-Origin", origin);
+        MHD_add_response_header(r, MHD_HTTP_HEADER_VARY, "Origin");
+    }
     result ret = MHD_queue_response(c, status, r);
     MHD_destroy_response(r);
     if (status >= 200 && status < 600)
@@ -619,6 +673,12 @@ static result route(tk_api *a, conn *c, const char *url, const char *method, con
 {
     bool get = !strcmp(method, "GET") || !strcmp(method, "HEAD");
     const char *allow = "GET";
+    if (!strcmp(method, "OPTIONS") && allowed_origin(a, c)) { /* a CORS preflight */
+        const char *headers[] = {"Access-Control-Allow-Methods", "GET, POST, DELETE",
+                                 "Access-Control-Allow-Headers", "Content-Type, Authorization",
+                                 "Access-Control-Max-Age", "600", NULL};
+        return send_buffer(a, c, 204, NULL, NULL, 0, headers);
+    }
     if (!strcmp(url, "/v1/jobs") && !strcmp(method, "POST"))
         return post_job(a, c, rq);
     if (!strcmp(url, "/v1/jobs")) {
@@ -696,6 +756,10 @@ static result handle(void *cls, conn *c, const char *url, const char *method,
     if (!rq) {
         if (!(*con_cls = rq = calloc(1, sizeof *rq)))
             return MHD_NO;
+        char why[600];
+        unsigned refused = boundary(a, c, why, sizeof why);
+        if (refused) /* answered before any body is read */
+            return problem(a, c, refused, NULL, NULL, "%s", why);
         const char *length = MHD_lookup_connection_value(c, MHD_HEADER_KIND,
                                                          MHD_HTTP_HEADER_CONTENT_LENGTH);
         rq->too_large = post && length && strtoull(length, NULL, 10) > a->cfg.max_body;
@@ -928,6 +992,14 @@ int tk_api_start(const tk_api_config *cfg, tk_pool *pool, tk_store *store, tk_ap
     }
     if (cfg->catalogue)
         load_catalogue(a);
+    /* all interfaces: loopback's names, and those given */
+    bool any = !strcmp(cfg->bind, "0.0.0.0");
+    if (asprintf(&a->hosts, "%s,localhost%s%s", any ? "127.0.0.1" : cfg->bind,
+                 cfg->hosts ? "," : "", cfg->hosts ? cfg->hosts : "") < 0) {
+        a->hosts = NULL;
+        tk_api_stop(&a);
+        return tk_error_set(err, TK_ENOMEM, "out of memory");
+    }
     a->daemon = MHD_start_daemon(
         MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_EPOLL, 0, NULL, NULL, handle, a,
         MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr, MHD_OPTION_THREAD_POOL_SIZE,
@@ -972,6 +1044,7 @@ void tk_api_stop(tk_api **p)
     for (size_t i = 0; i < (*p)->nentries; i++)
         free((*p)->entries[i].name);
     free((*p)->entries);
+    free((*p)->hosts);
     free((*p)->web);
     free(*p);
     *p = NULL;

@@ -21,6 +21,9 @@ typedef struct tk_api_config {
     size_t threads;         /* threads answering requests */
     const char *web;        /* the page's files, or NULL */
     const char *catalogue;  /* a directory of *.vect offered by name, or NULL */
+    const char *hosts;      /* names served besides the bind address and localhost
+                               (comma-separated), or NULL */
+    const char *allow_origins; /* other origins whose pages may call (comma-separated) */
 } tk_api_config;
 
 typedef struct tk_api tk_api;

@@ -51,6 +51,12 @@ int main(int argc, char **argv)
     tk_cli_text(&cli, "catalogue", 0, "DIR", &set.api.catalogue, "offer DIR's *.vect files at "
                 "/v1/catalogue");
     tk_cli_text(&cli, "web", 0, "DIR", &set.api.web, "serve the page's files from DIR at /");
+    tk_cli_text(&cli, "host", 0, "NAMES", &set.api.hosts, "host names (or addresses) clients "
+                "reach the daemon by, comma-separated, besides the bind address and localhost "
+                "(other Host headers get 421)");
+    tk_cli_text(&cli, "allow-origin", 0, "ORIGINS", &set.api.allow_origins, "origins "
+                "(https://example.org) whose pages may call the API, comma-separated; requests "
+                "from other pages get 403");
     tk_cli_text(&cli, "worker-priority", 0, "P", &priority, "how workers yield the CPU to "
                 "requests: idle (default: only CPU nothing else wants), low (niceness 5) or "
                 "normal (a machine shared with other busy programs, which idle could starve)");

@@ -24,10 +24,11 @@ export const ARTIFACTS = join(ROOT, 'test-artifacts', 'web');
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
 // Resolves to { base, stop }: base is the daemon's http://host:port, and
-// stop() ends it and removes its directory.
-export async function startDaemon() {
+// stop() ends it and removes its directory.  `extra`: more options.
+export async function startDaemon(extra = []) {
     const tmp = mkdtempSync(join(tmpdir(), 'tk-web-'));
-    const args = ['--port', '0', '--db', join(tmp, 'jobs.db'), '--catalogue', CATALOGUE, '--web', WEB, '--workers', '2'];
+    const args = ['--port', '0', '--db', join(tmp, 'jobs.db'), '--catalogue', CATALOGUE, '--web', WEB, '--workers', '2',
+        ...extra];
     const daemon = spawn(DAEMON, args, { stdio: ['ignore', 'pipe', 'pipe'] });
     const stop = async () => {
         if (daemon.exitCode === null && daemon.signalCode === null) {

@@ -21,7 +21,7 @@ fail() {
 [ -d node_modules/playwright-core ] || fail "node_modules/playwright-core is missing (run npm install)"
 sh tools/build-web.sh "$web" || fail "tools/build-web.sh failed"
 
-files=tests/web/page.test.mjs
+files="tests/web/page.test.mjs tests/web/boundary.test.mjs"
 skipped=0
 skip_firefox() {
     echo "FAIL tests/web/firefox.test.mjs not run: $*" >&2
