@@ -64,7 +64,7 @@ COMMON_LIB := $(BUILD)/libtkcommon.a
 SERVER_SRC := $(filter-out server/tightknotd.c,$(wildcard server/*.c))
 SERVER_OBJ := $(SERVER_SRC:%.c=$(BUILD)/%.o)
 SERVER_LIB := $(BUILD)/libtkserver.a
-SERVER_LIBS := -lmicrohttpd -ljansson -lsqlite3
+SERVER_LIBS := -lmicrohttpd -ljansson -lsqlite3 -lgnutls
 DAEMON := $(BUILD)/tightknotd
 
 CLI_SRC := $(wildcard tools/tightknot*.c)

@@ -98,7 +98,17 @@ typedef struct request {
     char *body;
     size_t len, cap;
     bool too_large, crowded;
+    const char *who; /* the token's name (with --tokens), else NULL */
+    bool admin;
 } request;
+
+/* Whether the client may see the job: without tokens anyone, else its
+ * owner and admin names. */
+static bool visible(const request *rq, const json_t *doc)
+{
+    const char *owner = json_string_value(json_object_get(doc, "owner"));
+    return !rq->who || rq->admin || (owner && !strcmp(owner, rq->who));
+}
 
 /* ---- answers ---- */
 
@@ -222,7 +232,7 @@ static int get_job(tk_api *a, int64_t id, json_t **doc, tk_error *err)
     return *doc ? TK_OK : tk_store_get(a->store, id, doc, err);
 }
 
-static result list_jobs(tk_api *a, conn *c)
+static result list_jobs(tk_api *a, conn *c, const request *rq)
 {
     result ret = MHD_NO;
     long offset, limit;
@@ -238,7 +248,8 @@ static result list_jobs(tk_api *a, conn *c)
     json_t *docs = NULL, *doc;
     size_t total = 0, i;
     tk_error err;
-    int rc = tk_store_list(a->store, state, (size_t)offset, (size_t)limit, &docs, &total, &err);
+    int rc = tk_store_list(a->store, state, rq->admin ? NULL : rq->who, (size_t)offset,
+                           (size_t)limit, &docs, &total, &err);
     if (rc) {
         json_decref(docs);
         return store_problem(a, c, rc, &err);
@@ -340,6 +351,7 @@ static result post_job(tk_api *a, conn *c, const request *rq)
     } else {
         /* the reader refuses a NUL anywhere: the text is a C string */
         json_t *doc = tk_job_new(sub.name, &sub.options, curve->ncomp, curve->nvert);
+        json_object_set_new(doc, "owner", rq->who ? json_string(rq->who) : json_null());
         char *input = strndup(sub.vect, sub.len);
         int rc = doc && input ? tk_pool_submit(a->pool, doc, input, &err)
                               : tk_error_set(&err, TK_ENOMEM, "out of memory");
@@ -364,11 +376,22 @@ static result post_job(tk_api *a, conn *c, const request *rq)
     return ret;
 }
 
-static result cancel_job(tk_api *a, conn *c, int64_t id)
+static result cancel_job(tk_api *a, conn *c, int64_t id, const request *rq)
 {
     json_t *doc = NULL;
     tk_error err;
-    int rc = tk_pool_cancel(a->pool, id, &doc, &err);
+    int rc = rq->who ? get_job(a, id, &doc, &err) : TK_OK;
+    if (rc)
+        return store_problem(a, c, rc, &err);
+    bool refused = doc && !visible(rq, doc);
+    const char *owner = json_string_value(json_object_get(doc, "owner"));
+    result ret = refused ? PROBLEM(a, c, 403, "job %lld is not yours to cancel: %.64s submitted "
+                                   "it", (long long)id, owner ? owner : "a client without a name")
+                         : MHD_YES;
+    json_decref(doc);
+    if (refused)
+        return ret;
+    rc = tk_pool_cancel(a->pool, id, &doc, &err);
     if (rc == TK_EINVAL && (rc = tk_store_delete(a->store, id, &err)) == TK_OK)
         return send_buffer(a, c, 204, NULL, NULL, 0, NULL); /* ended: it goes */
     if (rc == TK_EBUSY)
@@ -684,7 +707,7 @@ static result route(tk_api *a, conn *c, const char *url, const char *method, con
     if (!strcmp(url, "/v1/jobs")) {
         allow = "GET, POST";
         if (get)
-            return list_jobs(a, c);
+            return list_jobs(a, c, rq);
     } else if (!strncmp(url, "/v1/jobs/", 9)) {
         char *end = NULL;
         errno = 0;
@@ -700,11 +723,15 @@ static result route(tk_api *a, conn *c, const char *url, const char *method, con
         if (k == 5)
             return PROBLEM(a, c, 404, "no such resource: %.200s", url);
         if (k == 0 && !strcmp(method, "DELETE"))
-            return cancel_job(a, c, id);
+            return cancel_job(a, c, id, rq);
         allow = k ? "GET" : "GET, DELETE";
         json_t *doc = NULL;
         tk_error err;
         int rc = get ? get_job(a, id, &doc, &err) : TK_OK;
+        if (!rc && get && !visible(rq, doc)) { /* another name's: not there for this one */
+            json_decref(doc);
+            rc = tk_error_set(&err, TK_ENOTFOUND, "there is no job %lld", id);
+        }
         if (rc)
             return store_problem(a, c, rc, &err);
         if (get) {
@@ -760,6 +787,22 @@ static result handle(void *cls, conn *c, const char *url, const char *method,
         unsigned refused = boundary(a, c, why, sizeof why);
         if (refused) /* answered before any body is read */
             return problem(a, c, refused, NULL, NULL, "%s", why);
+        /* with tokens every request names its client, but health, the
+         * page's files and a preflight (browsers send no credentials) */
+        bool open = !strcmp(method, "OPTIONS") ||
+                    ((!strcmp(method, "GET") || !strcmp(method, "HEAD")) &&
+                     (!strcmp(url, "/v1/health") ||
+                      (strncmp(url, "/v1/", 4) && strcmp(url, "/v1") && strcmp(url, "/metrics"))));
+        if (a->cfg.tokens && !open &&
+            !(rq->who = tk_tokens_check(a->cfg.tokens,
+                                        MHD_lookup_connection_value(c, MHD_HEADER_KIND,
+                                                                    MHD_HTTP_HEADER_AUTHORIZATION),
+                                        &rq->admin))) {
+            const char *headers[] = {MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"tightknot\"",
+                                     NULL};
+            return problem(a, c, 401, NULL, headers, "this server needs a token: send "
+                           "'Authorization: Bearer TOKEN' (one of its --tokens file)");
+        }
         const char *length = MHD_lookup_connection_value(c, MHD_HEADER_KIND,
                                                          MHD_HTTP_HEADER_CONTENT_LENGTH);
         rq->too_large = post && length && strtoull(length, NULL, 10) > a->cfg.max_body;

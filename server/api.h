@@ -8,6 +8,7 @@
 #ifndef TK_SERVER_API_H
 #define TK_SERVER_API_H
 
+#include "auth.h"
 #include "pool.h"
 
 typedef struct tk_api_config {
@@ -24,6 +25,7 @@ typedef struct tk_api_config {
     const char *hosts;      /* names served besides the bind address and localhost
                                (comma-separated), or NULL */
     const char *allow_origins; /* other origins whose pages may call (comma-separated) */
+    const tk_tokens *tokens; /* the clients and their tokens, or NULL: open to anyone */
 } tk_api_config;
 
 typedef struct tk_api tk_api;

@@ -190,22 +190,33 @@ void tk_store_close(tk_store **p)
     *p = NULL;
 }
 
-int tk_store_add(tk_store *s, json_t *doc, const char *input, size_t limit, tk_error *err)
+int tk_store_add(tk_store *s, json_t *doc, const char *input, size_t limit, size_t per_owner,
+                 tk_error *err)
 {
     sqlite3 *db = take(s, err);
     if (!db)
         return TK_EIO;
     char *text = tk_json_dump(doc, false);
-    /* the limit and the insert in one statement: two requests cannot both
+    const char *owner = per_owner ? json_string_value(json_object_get(doc, "owner")) : NULL;
+    /* the limits and the insert in one statement: two requests cannot both
      * take the last place */
     sqlite3_stmt *st = prepare(db,
-                               "INSERT INTO jobs (state, doc, input) SELECT 'queued', ?, ?"
-                               " WHERE (SELECT count(*) FROM jobs WHERE state = 'queued') < ?",
-                               "tti", text, input, (int64_t)limit);
+                               "INSERT INTO jobs (state, doc, input) SELECT 'queued', ?1, ?2"
+                               " WHERE (SELECT count(*) FROM jobs WHERE state = 'queued') < ?3"
+                               " AND (?4 IS NULL OR (SELECT count(*) FROM jobs WHERE state IN"
+                               " ('queued', 'running') AND json_extract(doc, '$.owner') = ?4) < ?5)",
+                               "ttiti", text, input, (int64_t)limit, owner, (int64_t)per_owner);
     int rc = text && done(st) ? TK_OK : failed(db, err, "adding a job");
     free(text);
-    if (!rc && sqlite3_changes(db) == 0)
-        rc = tk_error_set(err, TK_EBUSY, "the queue is full (%zu jobs waiting)", limit);
+    if (!rc && sqlite3_changes(db) == 0) { /* which limit: the queue's, or the owner's */
+        sqlite3_stmt *q = owner ? prepare(db, "SELECT count(*) FROM jobs WHERE state = 'queued'",
+                                          "") : NULL;
+        bool full = !q || (sqlite3_step(q) == SQLITE_ROW && sqlite3_column_int64(q, 0) >= (int64_t)limit);
+        sqlite3_finalize(q);
+        rc = full ? tk_error_set(err, TK_EBUSY, "the queue is full (%zu jobs waiting)", limit)
+                  : tk_error_set(err, TK_EBUSY, "'%.64s' has %zu jobs queued or running, as many "
+                                 "as a name may (--jobs-per-name)", owner, per_owner);
+    }
     if (!rc)
         json_object_set_new(doc, "id", json_integer(sqlite3_last_insert_rowid(db)));
     give(s, db);
@@ -311,8 +322,8 @@ int tk_store_part(tk_store *s, int64_t id, tk_part part, char **text, size_t *le
     return one_text(s, prepare(db, sql, "i", (int64_t)id), db, text, len, err);
 }
 
-int tk_store_list(tk_store *s, int state, size_t offset, size_t limit, json_t **docs,
-                  size_t *total, tk_error *err)
+int tk_store_list(tk_store *s, int state, const char *owner, size_t offset, size_t limit,
+                  json_t **docs, size_t *total, tk_error *err)
 {
     *docs = json_array();
     *total = 0;
@@ -320,15 +331,14 @@ int tk_store_list(tk_store *s, int state, size_t offset, size_t limit, json_t **
     if (!db)
         return TK_EIO;
     const char *name = state >= 0 ? tk_job_states[state] : NULL;
-    sqlite3_stmt *st = prepare(db, "SELECT count(*) FROM jobs WHERE ?1 IS NULL OR state = ?1",
-                               "t", name);
+#define MATCHING " FROM jobs WHERE (?1 IS NULL OR state = ?1) AND (?2 IS NULL OR" \
+                 " json_extract(doc, '$.owner') = ?2)"
+    sqlite3_stmt *st = prepare(db, "SELECT count(*)" MATCHING, "tt", name, owner);
     bool ok = st && sqlite3_step(st) == SQLITE_ROW;
     *total = ok ? (size_t)sqlite3_column_int64(st, 0) : 0;
     sqlite3_finalize(st);
-    st = ok ? prepare(db,
-                      "SELECT doc, id, state FROM jobs WHERE ?1 IS NULL OR state = ?1 ORDER BY"
-                      " id DESC LIMIT ?2 OFFSET ?3",
-                      "tii", name, (int64_t)limit, (int64_t)offset)
+    st = ok ? prepare(db, "SELECT doc, id, state" MATCHING " ORDER BY id DESC LIMIT ?3 OFFSET ?4",
+                      "ttii", name, owner, (int64_t)limit, (int64_t)offset)
             : NULL;
     int step = SQLITE_ERROR;
     json_t *doc = NULL;
@@ -499,7 +509,7 @@ bool tk_store_health(tk_store *s, char *reason, size_t size)
     tk_error err;
     json_t *docs = NULL;
     size_t total = 0;
-    int rc = tk_store_list(s, -1, 0, 1, &docs, &total, &err);
+    int rc = tk_store_list(s, -1, NULL, 0, 1, &docs, &total, &err);
     json_decref(docs);
     if (rc)
         snprintf(reason, size, "the job store cannot be read: %s", err.message);

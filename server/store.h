@@ -39,8 +39,11 @@ int tk_store_open(const char *path, tk_store **out, tk_error *err);
 void tk_store_close(tk_store **p);
 
 /* Stores a new queued job (doc gets its id) with its input, unless
- * `limit` jobs are queued already (TK_EBUSY). */
-int tk_store_add(tk_store *s, json_t *doc, const char *input, size_t limit, tk_error *err);
+ * `limit` jobs are queued already, or (per_owner > 0) its owner (the
+ * document's "owner") has per_owner jobs queued or running (TK_EBUSY,
+ * saying which). */
+int tk_store_add(tk_store *s, json_t *doc, const char *input, size_t limit, size_t per_owner,
+                 tk_error *err);
 
 /* Writes a job: its document (and state from it), the parts that are not
  * NULL, and its frames from number `first` on (later ones dropped), in
@@ -54,10 +57,10 @@ int tk_store_get(tk_store *s, int64_t id, json_t **doc, tk_error *err);
 /* One part; *text NULL when it was never stored (free with free()). */
 int tk_store_part(tk_store *s, int64_t id, tk_part part, char **text, size_t *len, tk_error *err);
 
-/* Documents newest first, those in `state` only (-1: all), a page of
- * them; *total counts all that match. */
-int tk_store_list(tk_store *s, int state, size_t offset, size_t limit, json_t **docs,
-                  size_t *total, tk_error *err);
+/* Documents newest first, those in `state` only (-1: all) and of
+ * `owner` only (NULL: all), a page of them; *total counts all that match. */
+int tk_store_list(tk_store *s, int state, const char *owner, size_t offset, size_t limit,
+                  json_t **docs, size_t *total, tk_error *err);
 
 /* The oldest queued job becomes running: its id; TK_ENOTFOUND when none. */
 int tk_store_claim(tk_store *s, int64_t *id, tk_error *err);

@@ -25,6 +25,9 @@ static const tk_field fields[] = {
     ROW(pool.workers, workers, SIZE, 0, 0, 256, "threads running the engine, 0 for one per core"),
     ROW(pool.queue_limit, queue_limit, SIZE, 1000, 1, 1e7,
         "queued jobs before submissions get 429"),
+    ROW(pool.per_owner, jobs_per_name, SIZE, 100, 0, 1e7,
+        "with --tokens: queued and running jobs a name may have before its submissions get "
+        "429 (0: any number)"),
     ROW(api.max_vertices, max_vertices, SIZE, 200000, 3, TK_RUN_MAX_VERTICES,
         "largest knot accepted, after re-resolution"),
     ROW(api.max_body, max_body, SIZE, 16 << 20, 64, 0x1p32, "largest request body in bytes"),
@@ -39,10 +42,10 @@ static const tk_field fields[] = {
 
 int main(int argc, char **argv)
 {
-    const char *db = "var/tightknot.db", *priority = "idle";
+    const char *db = "var/tightknot.db", *priority = "idle", *tokens_file = NULL;
     settings set = {.api = {.bind = "127.0.0.1"}, .pool = {.flush_seconds = 2.0, .history = 2000}};
     tk_cli_defaults(fields, sizeof fields / sizeof fields[0], &set);
-    bool help = false;
+    bool help = false, anonymous = false;
     tk_cli cli = {.n = 0};
     tk_cli_text(&cli, "bind", 0, "ADDR", &set.api.bind, "IPv4 address to listen on (default "
                 "127.0.0.1)");
@@ -60,6 +63,12 @@ int main(int argc, char **argv)
     tk_cli_text(&cli, "worker-priority", 0, "P", &priority, "how workers yield the CPU to "
                 "requests: idle (default: only CPU nothing else wants), low (niceness 5) or "
                 "normal (a machine shared with other busy programs, which idle could starve)");
+    tk_cli_text(&cli, "tokens", 0, "FILE", &tokens_file, "the clients: a line 'NAME TOKEN' "
+                "or 'NAME sha256:HEX' each, 'admin' after it for a name that may cancel any "
+                "job; every request but health and the page then needs 'Authorization: Bearer "
+                "TOKEN', and a name sees its own jobs");
+    tk_cli_flag(&cli, "allow-anonymous", 0, &anonymous, "listen on an address other than "
+                "loopback without --tokens (anyone who reaches it may submit and cancel)");
     tk_cli_fields(&cli, fields, sizeof fields / sizeof fields[0], &set);
     tk_cli_flag(&cli, "help", 'h', &help, "this text");
     tk_error err;
@@ -90,6 +99,12 @@ int main(int argc, char **argv)
                        "normal\n", priority), 1;
     tk_api_config api = set.api;
     tk_pool_config pool_cfg = set.pool;
+    if (!tokens_file && !anonymous && strncmp(api.bind, "127.", 4))
+        return fprintf(stderr, "tightknotd: --bind %s without --tokens would let anyone who "
+                       "reaches it submit and cancel jobs: give --tokens FILE, or "
+                       "--allow-anonymous\n", api.bind), 1;
+    if (!tokens_file)
+        pool_cfg.per_owner = 0;
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     if (!pool_cfg.workers)
         pool_cfg.workers = cores > 0 ? (size_t)cores : 1;
@@ -114,14 +129,18 @@ int main(int argc, char **argv)
     snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - db) : 0, db);
     if (slash && slash != db)
         mkdir(dir, 0777); /* one level, as var/ is */
+    tk_tokens *tokens = NULL;
     tk_store *store = NULL;
     tk_pool *pool = NULL;
     tk_api *server = NULL;
-    if (tk_store_open(db, &store, &err) || tk_pool_start(store, &pool_cfg, &pool, &err) ||
+    int rc = tokens_file ? tk_tokens_load(tokens_file, &tokens, &err) : TK_OK;
+    api.tokens = tokens;
+    if (rc || tk_store_open(db, &store, &err) || tk_pool_start(store, &pool_cfg, &pool, &err) ||
         tk_api_start(&api, pool, store, &server, &err)) {
         fprintf(stderr, "tightknotd: %s\n", err.message);
         tk_pool_free(&pool);
         tk_store_close(&store);
+        tk_tokens_free(&tokens);
         return 2;
     }
     printf("tightknotd: listening on http://%s:%u/ (workers %zu, store %s", api.bind,
@@ -142,6 +161,7 @@ int main(int argc, char **argv)
     tk_api_stop(&server);
     tk_pool_free(&pool);
     tk_store_close(&store);
+    tk_tokens_free(&tokens);
     printf("tightknotd: stopped\n");
     return 0;
 }

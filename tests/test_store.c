@@ -55,7 +55,7 @@ static int64_t add_job(tk_store *s, const char *name)
     o.run.max_steps = 77;
     json_t *doc = tk_job_new(name, &o, 1, 3);
     tk_error err;
-    ck_assert_msg(tk_store_add(s, doc, input, 1000, &err) == TK_OK, "%s", err.message);
+    ck_assert_msg(tk_store_add(s, doc, input, 1000, 0, &err) == TK_OK, "%s", err.message);
     int64_t id = tk_job_id(doc);
     ck_assert_int_gt(id, 0);
     json_decref(doc);
@@ -157,13 +157,13 @@ START_TEST(listing_is_newest_first_filtered_and_paged)
     ck_assert_int_eq(tk_store_cancel(s, ids[5], &err), TK_OK);
     json_t *docs = NULL;
     size_t total = 0;
-    ck_assert_int_eq(tk_store_list(s, -1, 1, 3, &docs, &total, &err), TK_OK);
+    ck_assert_int_eq(tk_store_list(s, -1, NULL, 1, 3, &docs, &total, &err), TK_OK);
     ck_assert_uint_eq(total, 7);
     ck_assert_uint_eq(json_array_size(docs), 3);
     for (size_t i = 0; i < 3; i++)
         ck_assert_int_eq(tk_job_id(json_array_get(docs, i)), ids[5 - i]);
     json_decref(docs);
-    ck_assert_int_eq(tk_store_list(s, TK_JOB_CANCELLED, 0, 10, &docs, &total, &err), TK_OK);
+    ck_assert_int_eq(tk_store_list(s, TK_JOB_CANCELLED, NULL, 0, 10, &docs, &total, &err), TK_OK);
     ck_assert_uint_eq(total, 2);
     ck_assert_int_eq(tk_job_id(json_array_get(docs, 0)), ids[5]);
     ck_assert_int_eq(tk_job_id(json_array_get(docs, 1)), ids[2]);
@@ -241,7 +241,7 @@ START_TEST(the_queue_limit_holds_and_ends_are_final)
     tk_error err;
     for (int i = 0; i < 4; i++) {
         json_t *doc = tk_job_new("k", &o, 1, 3);
-        ck_assert_int_eq(tk_store_add(s, doc, input, 3, &err), i < 3 ? TK_OK : TK_EBUSY);
+        ck_assert_int_eq(tk_store_add(s, doc, input, 3, 0, &err), i < 3 ? TK_OK : TK_EBUSY);
         json_decref(doc);
     }
     ck_assert(strstr(err.message, "queue is full"));
@@ -274,7 +274,7 @@ START_TEST(readers_do_not_wait_for_a_writer)
     size_t total = 0;
     tk_error err;
     char *text = NULL;
-    ck_assert_int_eq(tk_store_list(s, -1, 0, 10, &docs, &total, &err), TK_OK);
+    ck_assert_int_eq(tk_store_list(s, -1, NULL, 0, 10, &docs, &total, &err), TK_OK);
     ck_assert_uint_eq(total, 1);
     ck_assert_int_eq(tk_store_part(s, id, TK_PART_CURVE, &text, NULL, &err), TK_OK);
     ck_assert_ptr_null(text); /* not yet committed */

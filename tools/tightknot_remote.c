@@ -60,6 +60,8 @@ const char tk_remote_help[] =
     "Options:\n"
     "  --server URL   the service (default $TIGHTKNOT_SERVER, else\n"
     "                 http://127.0.0.1:8080)\n"
+    "  --token TOKEN  sent as 'Authorization: Bearer TOKEN' to a server with\n"
+    "                 --tokens (default $TIGHTKNOT_TOKEN)\n"
     "  --poll SECONDS how often to ask for progress (default 1)\n"
     "  --json         status: print the jobs as JSON, one per line\n"
     "\n"
@@ -80,6 +82,7 @@ typedef struct buffer {
 typedef struct client {
     CURL *curl;
     char base[1024];
+    const char *token; /* sent as a bearer token, or NULL */
     char error[CURL_ERROR_SIZE];
     bool tty;
 } client;
@@ -149,6 +152,11 @@ static bool request(client *c, const char *method, const char *path, const char 
         curl_easy_setopt(h, CURLOPT_POSTFIELDSIZE_LARGE, (curl_off_t)len);
     }
     headers = curl_slist_append(headers, "Accept: application/json, text/plain");
+    if (c->token) {
+        char line[1024];
+        snprintf(line, sizeof line, "Authorization: Bearer %s", c->token);
+        headers = curl_slist_append(headers, line);
+    }
     curl_easy_setopt(h, CURLOPT_HTTPHEADER, headers);
     c->error[0] = '\0';
     CURLcode rc = curl_easy_perform(h);
@@ -849,7 +857,7 @@ static int cmd_jobs(client *c, const char *what, const run_args *a, bool json, i
 
 int tk_remote_main(int argc, char **argv)
 {
-    const char *server = getenv("TIGHTKNOT_SERVER");
+    const char *server = getenv("TIGHTKNOT_SERVER"), *token = getenv("TIGHTKNOT_TOKEN");
     if (!server || !*server)
         server = "http://127.0.0.1:8080";
     run_args a = {.out = "tightknot-results"};
@@ -860,6 +868,7 @@ int tk_remote_main(int argc, char **argv)
     tk_cli_flag(&cli, "help", 'h', &help, NULL);
     tk_cli_flag(&cli, "json", 0, &json, NULL);
     tk_cli_text(&cli, "server", 0, "URL", &server, NULL);
+    tk_cli_text(&cli, "token", 0, "TOKEN", &token, NULL);
     tk_cli_text(&cli, "out", 0, "DIR", &a.out, NULL);
     tk_cli_fields(&cli, run_arg_fields, 2, &a);
     tk_cli_fields(&cli, tk_job_option_fields, tk_job_option_nfields, &job);
@@ -907,6 +916,11 @@ int tk_remote_main(int argc, char **argv)
         return REMOTE_USAGE;
     }
     snprintf(c.base, sizeof c.base, "%.*s", (int)blen, server);
+    c.token = token && *token ? token : NULL;
+    if (c.token && strcspn(c.token, "\r\n") != strlen(c.token)) {
+        fprintf(stderr, "tightknot remote: --token: a token is one line\n");
+        return REMOTE_USAGE;
+    }
     c.tty = isatty(STDERR_FILENO) != 0;
     if (curl_global_init(CURL_GLOBAL_DEFAULT) != CURLE_OK || !(c.curl = curl_easy_init())) {
         fprintf(stderr, "tightknot remote: cannot start libcurl\n");

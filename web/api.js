@@ -10,8 +10,15 @@ export class ApiError extends Error {
     }
 }
 
-async function request(method, path, { json, text, signal } = {}) {
+// A server started with --tokens answers 401 without a token: the page
+// asks for one and keeps it for the session (this tab) only.
+const TOKEN_KEY = 'tightknot.token';
+
+async function request(method, path, options = {}, asked = false) {
+    const { json, text, signal } = options;
     const init = { method, headers: { Accept: 'application/json' }, signal, cache: 'no-store' };
+    const token = sessionStorage.getItem(TOKEN_KEY);
+    if (token) init.headers.Authorization = `Bearer ${token}`;
     if (json !== undefined) {
         init.headers['Content-Type'] = 'application/json';
         init.body = JSON.stringify(json);
@@ -32,6 +39,16 @@ async function request(method, path, { json, text, signal } = {}) {
         try { body = await res.json(); } catch { body = null; }
     } else {
         body = await res.text();
+    }
+    if (res.status === 401 && !asked) {
+        // another request may have asked meanwhile
+        const now = sessionStorage.getItem(TOKEN_KEY);
+        if (now && now !== token) return request(method, path, options, true);
+        const given = window.prompt(`${body?.detail || 'This server needs a token.'}\nYour token:`);
+        if (given) {
+            sessionStorage.setItem(TOKEN_KEY, given.trim());
+            return request(method, path, options, true);
+        }
     }
     if (!res.ok) {
         const problem = body && typeof body === 'object' ? body

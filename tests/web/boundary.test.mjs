@@ -119,3 +119,41 @@ test('a name that is not the daemon\'s (DNS rebinding) gets 421, the page and th
         await d.stop();
     }
 });
+
+test('with --tokens the page asks for a token once, keeps it for the session, and lists the jobs', async () => {
+    const { mkdtempSync, writeFileSync } = await import('node:fs');
+    const { tmpdir } = await import('node:os');
+    const { join } = await import('node:path');
+    const dir = mkdtempSync(join(tmpdir(), 'tk-web-tokens-'));
+    writeFileSync(join(dir, 'tokens'), 'ann ann-token-1\n');
+    const d = await startDaemon(['--tokens', join(dir, 'tokens')]);
+    const context = await browser.newContext();
+    const p = await context.newPage();
+    try {
+        const job = await api(d.base, '/v1/jobs?steps=3', { method: 'POST',
+            headers: { 'Content-Type': 'text/plain', Authorization: 'Bearer ann-token-1' }, body: SQUARE });
+        assert.equal(job.status, 202);
+        const asked = [];
+        p.on('dialog', async (dialog) => {
+            asked.push(dialog.message());
+            await dialog.accept('ann-token-1');
+        });
+        await p.goto(`${d.base}/`);
+        // the catalogue loads once the token is given
+        await p.waitForFunction(() => document.querySelectorAll('#catalogue-select option').length > 0,
+            null, { timeout: 20000 });
+        assert.equal(asked.length, 1, `asked ${asked.length} times: ${asked.join(' | ')}`);
+        assert.match(asked[0], /needs a token/);
+        assert.equal(await p.evaluate(() => sessionStorage.getItem('tightknot.token')), 'ann-token-1');
+        // its job is listed: the page's requests carry the token
+        const listed = await p.evaluate(async () => (await fetch('/v1/jobs', {
+            headers: { Authorization: `Bearer ${sessionStorage.getItem('tightknot.token')}` } })).json());
+        assert.equal(listed.total, 1);
+        await p.reload();
+        await p.waitForFunction(() => document.querySelectorAll('#catalogue-select option').length > 0);
+        assert.equal(asked.length, 1, 'not asked again in the same session');
+    } finally {
+        await context.close();
+        await d.stop();
+    }
+});

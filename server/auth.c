@@ -1,0 +1,99 @@
+/* tightknot service: who is asking (see auth.h). */
+#define _GNU_SOURCE
+#include "auth.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include <gnutls/crypto.h>
+
+typedef struct entry {
+    char name[64];
+    unsigned char hash[32];
+    bool admin;
+} entry;
+
+struct tk_tokens {
+    entry *e;
+    size_t n;
+};
+
+static int from_hex(const char *hex, unsigned char out[32])
+{
+    for (int i = 0; i < 32; i++)
+        if (sscanf(hex + 2 * i, "%2hhx", &out[i]) != 1)
+            return -1;
+    return strspn(hex, "0123456789abcdefABCDEF") == 64 && !hex[64] ? 0 : -1;
+}
+
+int tk_tokens_load(const char *path, tk_tokens **out, tk_error *err)
+{
+    *out = NULL;
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return tk_error_set(err, TK_EIO, "--tokens: cannot read %s", path);
+    tk_tokens *t = calloc(1, sizeof *t);
+    char *line = NULL;
+    size_t cap = 0;
+    int rc = t ? TK_OK : tk_error_set(err, TK_ENOMEM, "out of memory");
+    for (long no = 1; !rc && getline(&line, &cap, f) >= 0; no++) {
+        line[strcspn(line, "#\r\n")] = '\0';
+        char name[64], token[512], mark[16], extra;
+        int k = sscanf(line, "%63s %511s %15s %c", name, token, mark, &extra);
+        if (k <= 0)
+            continue; /* blank or a comment */
+        entry e = {.admin = k >= 3 && !strcmp(mark, "admin")};
+        snprintf(e.name, sizeof e.name, "%s", name);
+        bool hashed = !strncasecmp(token, "sha256:", 7);
+        entry *grown = NULL;
+        if (k < 2 || k > 3 || (k == 3 && !e.admin) || strlen(name) > 62 ||
+            (hashed && from_hex(token + 7, e.hash)))
+            rc = tk_error_set(err, TK_EPARSE, "%s:%ld: expected 'NAME TOKEN' or 'NAME "
+                              "sha256:HEX' (64 hex digits), then optionally 'admin'", path, no);
+        else if (!hashed && gnutls_hash_fast(GNUTLS_DIG_SHA256, token, strlen(token), e.hash))
+            rc = tk_error_set(err, TK_EIO, "--tokens: cannot hash a token");
+        else if (!(grown = realloc(t->e, (t->n + 1) * sizeof *grown)))
+            rc = tk_error_set(err, TK_ENOMEM, "out of memory");
+        else
+            (t->e = grown)[t->n++] = e;
+    }
+    free(line);
+    fclose(f);
+    if (!rc && t->n == 0)
+        rc = tk_error_set(err, TK_EPARSE, "%s: no tokens", path);
+    if (rc)
+        tk_tokens_free(&t);
+    *out = t;
+    return rc;
+}
+
+void tk_tokens_free(tk_tokens **t)
+{
+    if (!t || !*t)
+        return;
+    free((*t)->e);
+    free(*t);
+    *t = NULL;
+}
+
+const char *tk_tokens_check(const tk_tokens *t, const char *authorization, bool *admin)
+{
+    unsigned char hash[32];
+    *admin = false;
+    if (!authorization || strncasecmp(authorization, "Bearer ", 7) ||
+        gnutls_hash_fast(GNUTLS_DIG_SHA256, authorization + 7, strlen(authorization + 7), hash))
+        return NULL;
+    const char *name = NULL;
+    for (size_t i = 0; i < t->n; i++) {
+        unsigned char differ = 0; /* every byte compared: no timing to learn from */
+        for (int k = 0; k < 32; k++)
+            differ |= (unsigned char)(hash[k] ^ t->e[i].hash[k]);
+        if (!differ && !name) {
+            name = t->e[i].name;
+            *admin = t->e[i].admin;
+        }
+    }
+    return name;
+}
