@@ -350,8 +350,7 @@ static result post_job(tk_api *a, conn *c, const request *rq)
                       a->cfg.max_vertices);
     } else {
         /* the reader refuses a NUL anywhere: the text is a C string */
-        json_t *doc = tk_job_new(sub.name, &sub.options, curve->ncomp, curve->nvert);
-        json_object_set_new(doc, "owner", rq->who ? json_string(rq->who) : json_null());
+        json_t *doc = tk_job_new(sub.name, rq->who, &sub.options, curve->ncomp, curve->nvert);
         char *input = strndup(sub.vect, sub.len);
         int rc = doc && input ? tk_pool_submit(a->pool, doc, input, &err)
                               : tk_error_set(&err, TK_ENOMEM, "out of memory");

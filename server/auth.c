@@ -48,10 +48,11 @@ int tk_tokens_load(const char *path, tk_tokens **out, tk_error *err)
         snprintf(e.name, sizeof e.name, "%s", name);
         bool hashed = !strncasecmp(token, "sha256:", 7);
         entry *grown = NULL;
-        if (k < 2 || k > 3 || (k == 3 && !e.admin) || strlen(name) > 62 ||
+        if (k < 2 || k > 3 || (k == 3 && !e.admin) || strlen(name) > 62 || strlen(token) > 510 ||
             (hashed && from_hex(token + 7, e.hash)))
             rc = tk_error_set(err, TK_EPARSE, "%s:%ld: expected 'NAME TOKEN' or 'NAME "
-                              "sha256:HEX' (64 hex digits), then optionally 'admin'", path, no);
+                              "sha256:HEX' (64 hex digits; a name of at most 62 bytes, a token of at most 510), "
+                              "then optionally 'admin'", path, no);
         else if (!hashed && gnutls_hash_fast(GNUTLS_DIG_SHA256, token, strlen(token), e.hash))
             rc = tk_error_set(err, TK_EIO, "--tokens: cannot hash a token");
         else if (!(grown = realloc(t->e, (t->n + 1) * sizeof *grown)))

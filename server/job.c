@@ -28,8 +28,8 @@ int tk_job_options_of(const json_t *doc, tk_job_options *o, tk_error *err)
     return TK_OK;
 }
 
-json_t *tk_job_new(const char *name, const tk_job_options *o, size_t components,
-                   size_t vertices)
+json_t *tk_job_new(const char *name, const char *owner, const tk_job_options *o,
+                   size_t components, size_t vertices)
 {
     tk_job_options run = *o;
     tk_job_options_complete(&run);
@@ -44,6 +44,7 @@ json_t *tk_job_new(const char *name, const tk_job_options *o, size_t components,
         json_object_set_new(doc, tk_step_fields[i].name,
                             tk_step_fields[i].kind == TK_KIND_REAL ? json_null() : json_integer(0));
     json_object_set_new(doc, "vertices", json_integer((json_int_t)vertices));
+    json_object_set_new(doc, "owner", owner ? json_string(owner) : json_null());
     tk_job_stamp(doc, "created");
     return doc;
 }

@@ -1,7 +1,8 @@
 /* tightknot service: a job is one JSON document.
  *
  * The document is what GET /v1/jobs/{id} serves (openapi.yaml, Job) less
- * its links: what was asked (name, options), where the job stands (state,
+ * its links: what was asked (name, options) and by whom (owner: the name
+ * of its token, null without tokens), where the job stands (state,
  * progress, timestamps, stop reason, error, frames, knot type) and its
  * latest figures, which are the fields of the engine's step report under
  * their table's names (tk/tighten.h).  The store keeps it as it is, the
@@ -27,8 +28,8 @@ int tk_job_state_of(const char *name);
 int tk_job_options_of(const json_t *doc, tk_job_options *o, tk_error *err);
 
 /* A queued job's document, figures unknown (null), options complete. */
-json_t *tk_job_new(const char *name, const tk_job_options *o, size_t components,
-                   size_t vertices);
+json_t *tk_job_new(const char *name, const char *owner, const tk_job_options *o,
+                   size_t components, size_t vertices);
 
 /* Sets the figures of step r and the progress through the budget of o. */
 void tk_job_set_figures(json_t *doc, const tk_step_report *r, const tk_job_options *o);

@@ -76,7 +76,7 @@ START_TEST(json_options_round_trip)
                            0, "seed", 7, "coarse", 0, "overstep", 2e-5, "re_resolve", 0.0);
     tk_error err;
     ck_assert_int_eq(tk_job_options_from_json(&o, in, NULL, &err), TK_OK);
-    json_t *doc = tk_job_new("knot", &o, 1, 3);
+    json_t *doc = tk_job_new("knot", NULL, &o, 1, 3);
     ck_assert(json_equal(in, json_object_get(doc, "options")));
     tk_job_options back;
     ck_assert_int_eq(tk_job_options_of(doc, &back, &err), TK_OK);
@@ -135,7 +135,7 @@ START_TEST(no_stop_criterion_means_the_default_steps)
     ck_assert(o.run.overstep_tolerance == defaults.overstep_tolerance);
     /* a new job shows the budget it runs with */
     tk_job_options none = TK_JOB_OPTIONS_INIT;
-    json_t *doc = tk_job_new("knot", &none, 1, 3);
+    json_t *doc = tk_job_new("knot", NULL, &none, 1, 3);
     ck_assert_int_eq(json_integer_value(json_object_get(json_object_get(doc, "options"), "steps")),
                      TK_DEFAULT_STEPS);
     json_decref(doc);
@@ -150,7 +150,7 @@ START_TEST(the_document_carries_the_step_figures)
     tk_job_options o = TK_JOB_OPTIONS_INIT;
     o.run.max_steps = 200;
     o.run.max_seconds = 10.0;
-    json_t *doc = tk_job_new("knot", &o, 2, 96);
+    json_t *doc = tk_job_new("knot", NULL, &o, 2, 96);
     ck_assert_str_eq(json_string_value(json_object_get(doc, "state")), "queued");
     ck_assert_int_eq(json_integer_value(json_object_get(doc, "vertices")), 96);
     ck_assert_int_eq(json_integer_value(json_object_get(doc, "components")), 2);

@@ -53,7 +53,7 @@ static int64_t add_job(tk_store *s, const char *name)
 {
     tk_job_options o = TK_JOB_OPTIONS_INIT;
     o.run.max_steps = 77;
-    json_t *doc = tk_job_new(name, &o, 1, 3);
+    json_t *doc = tk_job_new(name, NULL, &o, 1, 3);
     tk_error err;
     ck_assert_msg(tk_store_add(s, doc, input, 1000, 0, &err) == TK_OK, "%s", err.message);
     int64_t id = tk_job_id(doc);
@@ -234,13 +234,50 @@ START_TEST(claims_take_each_queued_job_once_oldest_first)
 }
 END_TEST
 
+START_TEST(an_owner_limit_counts_its_queued_and_running_jobs)
+{
+    /* per owner, queued and running jobs count, others' and ended ones not;
+     * the listing by owner sees only that owner's */
+    tk_store *s = open_store();
+    tk_job_options o = TK_JOB_OPTIONS_INIT;
+    tk_error err;
+    const char *owners[] = {"ann", "ann", "ann", "bo", NULL};
+    const int expect[] = {TK_OK, TK_OK, TK_EBUSY, TK_OK, TK_OK};
+    for (int i = 0; i < 5; i++) {
+        json_t *doc = tk_job_new("k", owners[i], &o, 1, 3);
+        ck_assert_int_eq(tk_store_add(s, doc, input, 1000, 2, &err), expect[i]);
+        if (expect[i])
+            ck_assert_msg(strstr(err.message, "'ann' has 2 jobs queued or running"), "%s",
+                          err.message);
+        json_decref(doc);
+    }
+    int64_t id = 0;
+    ck_assert_int_eq(tk_store_claim(s, &id, &err), TK_OK); /* ann's first runs: still counts */
+    json_t *doc = tk_job_new("k", "ann", &o, 1, 3);
+    ck_assert_int_eq(tk_store_add(s, doc, input, 1000, 2, &err), TK_EBUSY);
+    ck_assert_int_eq(tk_store_cancel(s, 2, &err), TK_OK); /* her second ends: room */
+    ck_assert_int_eq(tk_store_add(s, doc, input, 1000, 2, &err), TK_OK);
+    json_decref(doc);
+    json_t *docs = NULL;
+    size_t total = 0;
+    ck_assert_int_eq(tk_store_list(s, -1, "ann", 0, 10, &docs, &total, &err), TK_OK);
+    ck_assert_uint_eq(total, 3);
+    ck_assert_uint_eq(json_array_size(docs), 3);
+    json_decref(docs);
+    ck_assert_int_eq(tk_store_list(s, TK_JOB_QUEUED, "bo", 0, 10, &docs, &total, &err), TK_OK);
+    ck_assert_uint_eq(total, 1);
+    json_decref(docs);
+    tk_store_close(&s);
+}
+END_TEST
+
 START_TEST(the_queue_limit_holds_and_ends_are_final)
 {
     tk_store *s = open_store();
     tk_job_options o = TK_JOB_OPTIONS_INIT;
     tk_error err;
     for (int i = 0; i < 4; i++) {
-        json_t *doc = tk_job_new("k", &o, 1, 3);
+        json_t *doc = tk_job_new("k", NULL, &o, 1, 3);
         ck_assert_int_eq(tk_store_add(s, doc, input, 3, 0, &err), i < 3 ? TK_OK : TK_EBUSY);
         json_decref(doc);
     }
@@ -376,6 +413,7 @@ int main(void)
     tcase_add_test(tc, listing_is_newest_first_filtered_and_paged);
     tcase_add_test(tc, claims_take_each_queued_job_once_oldest_first);
     tcase_add_test(tc, the_queue_limit_holds_and_ends_are_final);
+    tcase_add_test(tc, an_owner_limit_counts_its_queued_and_running_jobs);
     tcase_add_test(tc, readers_do_not_wait_for_a_writer);
     tcase_add_test(tc, an_unwritable_path_is_an_error);
     tcase_add_test(tc, a_first_version_store_becomes_documents);

@@ -75,7 +75,7 @@ static void check_domains(const tk_job_options *o)
 static void check_round_trip(const tk_job_options *o)
 {
     /* through the job's document, as the store keeps it */
-    json_t *doc = tk_job_new("fuzz", o, 1, 3);
+    json_t *doc = tk_job_new("fuzz", NULL, o, 1, 3);
     CHECK(doc);
     tk_job_options back, complete = *o;
     tk_job_options_complete(&complete);

@@ -56,7 +56,7 @@ static tk_store *the_store(void)
 static void store_and_read_back(const tk_submission *sub, const tk_curve *curve)
 {
     tk_store *store = the_store();
-    json_t *doc = tk_job_new(sub->name, &sub->options, curve->ncomp, curve->nvert);
+    json_t *doc = tk_job_new(sub->name, NULL, &sub->options, curve->ncomp, curve->nvert);
     char *input = strndup(sub->vect, sub->len);
     CHECK(doc && input);
     tk_error err;
