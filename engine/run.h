@@ -122,7 +122,8 @@ struct tk_run {
         size_t polish_from;  /* history entries before the last change of
                                 level or resampling */
         double resolved_at;  /* ropelength at the last re-resolution */
-        double start_ropelength; /* of the input, before any resampling */
+        double start_ropelength; /* of the input, before any resampling, by its
+                                    self-distance (the vertex counts' reference) */
         int coarse_level;    /* halvings of the vertex count still to undo */
         int coarse_levels;   /* of them at the start */
         bool move_on;        /* refine before the next step */
@@ -335,6 +336,7 @@ bool tk_schedule_move_on(tk_run *r);
  * spent. */
 bool tk_schedule_share_spent(const tk_run *r);
 bool tk_schedule_final(const tk_run *r);
+size_t tk_schedule_final_count(const tk_run *r);
 double tk_tolerance_active(const tk_run *r);
 double tk_tolerance_overstep(const tk_run *r);
 double tk_tolerance_correction(const tk_run *r);

@@ -96,6 +96,21 @@ static int measure(const tk_curve *c, tk_measure *m, tk_error *err)
     return rc;
 }
 
+/* The ropelength a resolution reckons vertices from: twice the length
+ * over the shortest self-distance, the start's ropelength but for its
+ * curvature.  A noisy or unevenly spaced polygon's radius of curvature is
+ * a fraction of its strands' distance (a Hopf link with each vertex moved
+ * by 5% of an edge: ropelength 64.7, against 25.2 by its self-distance)
+ * and its vertex count would follow that noise: a disguised Hopf link at
+ * resolution 5 got 709 vertices and was still at 36.1 after 120 s, a
+ * chain of three rings 1537 and 316.  Without a self-distance (one
+ * open arc) the ropelength itself. */
+static double reckoned_ropelength(const tk_measure *m)
+{
+    return isfinite(m->shortest) && m->shortest > 0.0 ? 2.0 * m->length / m->shortest
+                                                        : m->ropelength;
+}
+
 /* The resolution of the final polygon: the option's, or the vertices
  * asked for per unit of the start's ropelength (0: the input's polygon). */
 static double resolution_final(const tk_run *r)
@@ -112,6 +127,15 @@ static size_t level_count(const tk_run *r, double rope)
     if (r->opt.vertices > 0)
         return (size_t)ceil(ldexp((double)r->opt.vertices, -level));
     return (size_t)ceil(ldexp(r->opt.resolution, -level) * rope);
+}
+
+size_t tk_schedule_final_count(const tk_run *r)
+{
+    if (tk_schedule_final(r) || !(resolution_final(r) > 0.0))
+        return r->shared.curve->nvert;
+    if (r->opt.vertices > 0)
+        return r->opt.vertices;
+    return (size_t)ceil(r->opt.resolution * r->schedule.start_ropelength);
 }
 
 bool tk_schedule_final(const tk_run *r)
@@ -179,22 +203,25 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
         rc = measure(*curve, &m, err);
     if (rc)
         return rc;
-    r->schedule.start_ropelength = m.ropelength;
+    r->schedule.start_ropelength = reckoned_ropelength(&m);
+    double start_rope = m.ropelength;
     if (!(m.ropelength <= START_ROPELENGTH_MAX))
         return tk_error_set(err, TK_EINVAL,
                             "the curve is too thin for its length to tighten in double "
                             "precision: ropelength %.6g, above %g (does it nearly cross itself?)",
                             m.ropelength, START_ROPELENGTH_MAX);
     if (resolution_final(r) > 0.0) {
-        double want = (double)level_count(r, m.ropelength);
+        double want = (double)level_count(r, r->schedule.start_ropelength);
         if (want > TK_RUN_MAX_VERTICES)
             return tk_error_set(err, TK_ELIMIT,
                                 "resolution %g at ropelength %.4g asks for %.0f vertices: a "
                                 "run holds at most %d (about 2 GiB of memory)",
-                                r->opt.resolution, m.ropelength, want, TK_RUN_MAX_VERTICES);
+                                r->opt.resolution, r->schedule.start_ropelength, want,
+                                TK_RUN_MAX_VERTICES);
         r->schedule.coarse_level = r->schedule.coarse_levels = coarse_levels(r);
         tk_curve *resampled = NULL;
-        rc = tk_curve_resample_total(*curve, level_count(r, m.ropelength), &resampled, err);
+        rc = tk_curve_resample_total(*curve, level_count(r, r->schedule.start_ropelength),
+                                     &resampled, err);
         if (rc)
             return rc;
         tk_curve_free(curve);
@@ -207,7 +234,7 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
                                 "curve through the vertices loops where they turn sharply; "
                                 "tighten without a resolution first, or add vertices there",
                                 (*curve)->nvert, resolution_final(r), rc ? INFINITY : m.ropelength,
-                                r->schedule.start_ropelength);
+                                start_rope);
         if (rc)
             return rc;
     }

@@ -442,6 +442,11 @@ const tk_curve *tk_run_curve(const tk_run *r)
     return r->shared.curve;
 }
 
+size_t tk_run_final_vertices(const tk_run *r)
+{
+    return tk_schedule_final_count(r);
+}
+
 const tk_step_report *tk_run_latest(const tk_run *r)
 {
     return &r->life.latest;

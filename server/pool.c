@@ -363,18 +363,6 @@ static int setup(job_run *jr, const json_t *doc, tk_error *err)
     int rc = read_curve(jr, TK_PART_INPUT, &input, err);
     if (!rc)
         rc = tk_invariants_compute(input, &jr->input_type, err);
-    if (!rc && o.resolution > 0.0) { /* the vertices it asks for, measured first */
-        tk_options measure = o;
-        measure.resolution = 0.0;
-        measure.autoscale = true;
-        rc = tk_run_new(input, &measure, &jr->run, err);
-        double wanted = rc ? 0.0 : ceil(o.resolution * tk_run_latest(jr->run)->ropelength);
-        tk_run_free(&jr->run);
-        if (!rc && !(wanted <= (double)jr->pool->cfg.max_vertices))
-            rc = tk_error_set(err, TK_ELIMIT, "option 'resolution': %g vertices per unit "
-                              "ropelength make %.0f vertices; the limit is %zu",
-                              o.resolution, wanted, jr->pool->cfg.max_vertices);
-    }
     long step = tk_job_step(doc);
     if (!rc && step > 0) {
         rc = resume(jr, &o, doc, err);
@@ -388,6 +376,12 @@ static int setup(job_run *jr, const json_t *doc, tk_error *err)
     } else if (!rc) {
         rc = tk_run_new(input, &o, &jr->run, err);
     }
+    /* the polygon a resolution asks for, known once the start is measured */
+    size_t wanted = rc ? 0 : tk_run_final_vertices(jr->run);
+    if (wanted > jr->pool->cfg.max_vertices)
+        rc = tk_error_set(err, TK_ELIMIT, "option 'resolution': %g vertices per unit "
+                          "ropelength make %zu vertices; the limit is %zu",
+                          o.resolution, wanted, jr->pool->cfg.max_vertices);
     tk_curve_free(&input);
     return rc;
 }

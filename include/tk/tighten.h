@@ -71,7 +71,8 @@
     X(lambda, REAL, 1.0, 1e-30, 1e30, "lambda", "stiffness: minrad >= lambda x radius")      \
     X(resolution, REAL, 0.0, 0.0, 1e4, "resolution",                                         \
       "resample the start to resolution x ropelength vertices (5 quick, 10 medium, 20 "      \
-      "fine); 0 keeps the input's")                                                          \
+      "fine), its ropelength reckoned from its self-distance (2 length / shortest "          \
+      "self-distance: a noisy start's curvature does not count); 0 keeps the input's")      \
     X(vertices, SIZE, 0, 0, 1e6, "vertices",                                                 \
       "resample the start to this many vertices in all (coarse to fine as with a "          \
       "resolution), to compare with tables at a given vertex count (0: not; not with a "     \
@@ -203,6 +204,9 @@ void tk_run_cancel(tk_run *r);
 
 const tk_options *tk_run_options(const tk_run *r);
 const tk_curve *tk_run_curve(const tk_run *r);
+/* The vertices of the run's final polygon, now or once coarse to fine
+ * has reached it (re-resolution changes it later). */
+size_t tk_run_final_vertices(const tk_run *r);
 /* The latest figures (step 0 before the first step). */
 const tk_step_report *tk_run_latest(const tk_run *r);
 const tk_step_report *tk_run_history(const tk_run *r, size_t *count);

@@ -106,6 +106,13 @@ describe('malformed VECT gets 422 naming its line', () => {
         assert.equal(job.state, 'done');
         assert.equal(job.progress.step, 5);
     });
+
+    test('a resolution that asks for more vertices than the server takes: the job fails saying so', async () => {
+        const job = await waitFinal(d, (await submit(d, { catalogue: '3.1', options: { resolution: 10000, steps: 5 } })).id,
+            { timeout: 60000 });
+        assert.equal(job.state, 'failed', JSON.stringify(job));
+        assert.match(job.error, /option 'resolution': 10000 vertices per unit ropelength make \d+ vertices; the limit is 200000/);
+    });
 });
 
 describe("magnitudes outside the engine's range get 422, in time bounded by the input", () => {
