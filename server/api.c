@@ -32,6 +32,7 @@ typedef struct entry {
 
 struct tk_api {
     tk_api_config cfg;
+    char *tls_cert, *tls_key; /* PEM, or NULL: plain HTTP */
     char *hosts; /* the hosts served, comma-separated (the browser boundary) */
     char *web;
     entry *entries; /* the catalogue, sorted by name */
@@ -275,11 +276,10 @@ static const entry *find_entry(const tk_api *a, const char *name)
 }
 
 /* A file's whole text (NUL-terminated), or NULL. */
-static char *read_file(const char *dir, const char *name, const char *suffix, size_t *len)
+static char *slurp(const char *path, size_t *len)
 {
-    char *path = NULL, *text = NULL;
-    FILE *f = asprintf(&path, "%s/%s%s", dir, name, suffix) < 0 ? NULL : fopen(path, "rb");
-    free(path);
+    char *text = NULL;
+    FILE *f = path ? fopen(path, "rb") : NULL;
     if (f) {
         FILE *out = open_memstream(&text, len);
         char buf[65536];
@@ -290,6 +290,14 @@ static char *read_file(const char *dir, const char *name, const char *suffix, si
             fclose(out);
         fclose(f);
     }
+    return text;
+}
+
+static char *read_file(const char *dir, const char *name, const char *suffix, size_t *len)
+{
+    char *path = NULL;
+    char *text = asprintf(&path, "%s/%s%s", dir, name, suffix) < 0 ? NULL : slurp(path, len);
+    free(path);
     return text;
 }
 
@@ -1042,8 +1050,22 @@ int tk_api_start(const tk_api_config *cfg, tk_pool *pool, tk_store *store, tk_ap
         tk_api_stop(&a);
         return tk_error_set(err, TK_ENOMEM, "out of memory");
     }
+    size_t len = 0;
+    if (!cfg->tls_cert != !cfg->tls_key ||
+        (cfg->tls_cert && (!(a->tls_cert = slurp(cfg->tls_cert, &len)) ||
+                           !(a->tls_key = slurp(cfg->tls_key, &len))))) {
+        tk_error_set(err, TK_EIO, "--tls-cert and --tls-key: %s", cfg->tls_cert && cfg->tls_key
+                     ? "cannot read both files" : "give both, or neither");
+        tk_api_stop(&a);
+        return TK_EIO;
+    }
+    struct MHD_OptionItem tls[] = {{MHD_OPTION_HTTPS_MEM_CERT, 0, a->tls_cert},
+                                   {MHD_OPTION_HTTPS_MEM_KEY, 0, a->tls_key},
+                                   {MHD_OPTION_END, 0, NULL}};
+    errno = 0;
     a->daemon = MHD_start_daemon(
-        MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_EPOLL, 0, NULL, NULL, handle, a,
+        MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_EPOLL | (a->tls_cert ? MHD_USE_TLS : 0), 0,
+        NULL, NULL, handle, a, MHD_OPTION_ARRAY, a->tls_cert ? tls : tls + 2,
         MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr, MHD_OPTION_THREAD_POOL_SIZE,
         (unsigned)(cfg->threads ? cfg->threads : 2), MHD_OPTION_CONNECTION_LIMIT,
         (unsigned)cfg->max_connections, MHD_OPTION_PER_IP_CONNECTION_LIMIT,
@@ -1052,7 +1074,9 @@ int tk_api_start(const tk_api_config *cfg, tk_pool *pool, tk_store *store, tk_ap
         MHD_OPTION_END);
     if (!a->daemon) {
         tk_error_set(err, TK_EIO, "cannot listen on %s:%zu: %s", cfg->bind, cfg->port,
-                     errno ? strerror(errno) : "unknown error");
+                     errno ? strerror(errno)
+                           : a->tls_cert ? "the TLS certificate or key was refused"
+                                         : "unknown error");
         tk_api_stop(&a);
         return TK_EIO;
     }
@@ -1065,6 +1089,11 @@ unsigned tk_api_port(const tk_api *a)
     const union MHD_DaemonInfo *info = MHD_get_daemon_info(a->daemon,
                                                            MHD_DAEMON_INFO_BIND_PORT);
     return info ? info->port : (unsigned)a->cfg.port;
+}
+
+const char *tk_api_scheme(const tk_api *a)
+{
+    return a->tls_cert ? "https" : "http";
 }
 
 size_t tk_api_catalogue_size(const tk_api *a)
@@ -1087,6 +1116,8 @@ void tk_api_stop(tk_api **p)
         free((*p)->entries[i].name);
     free((*p)->entries);
     free((*p)->hosts);
+    free((*p)->tls_cert);
+    free((*p)->tls_key);
     free((*p)->web);
     free(*p);
     *p = NULL;

@@ -26,6 +26,7 @@ typedef struct tk_api_config {
                                (comma-separated), or NULL */
     const char *allow_origins; /* other origins whose pages may call (comma-separated) */
     const tk_tokens *tokens; /* the clients and their tokens, or NULL: open to anyone */
+    const char *tls_cert, *tls_key; /* PEM files: HTTPS; NULL: plain HTTP */
 } tk_api_config;
 
 typedef struct tk_api tk_api;
@@ -33,6 +34,7 @@ typedef struct tk_api tk_api;
 int tk_api_start(const tk_api_config *cfg, tk_pool *pool, tk_store *store, tk_api **out,
                  tk_error *err);
 unsigned tk_api_port(const tk_api *a);
+const char *tk_api_scheme(const tk_api *a); /* "http" or "https" */
 size_t tk_api_catalogue_size(const tk_api *a);
 void tk_api_refuse(tk_api *a); /* from now on every request gets 503 */
 void tk_api_stop(tk_api **p);

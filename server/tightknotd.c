@@ -67,6 +67,10 @@ int main(int argc, char **argv)
                 "or 'NAME sha256:HEX' each, 'admin' after it for a name that may cancel any "
                 "job; every request but health and the page then needs 'Authorization: Bearer "
                 "TOKEN', and a name sees its own jobs");
+    tk_cli_text(&cli, "tls-cert", 0, "FILE", &set.api.tls_cert, "serve HTTPS with this "
+                "certificate (PEM; with --tls-key)");
+    tk_cli_text(&cli, "tls-key", 0, "FILE", &set.api.tls_key, "the certificate's private key "
+                "(PEM)");
     tk_cli_flag(&cli, "allow-anonymous", 0, &anonymous, "listen on an address other than "
                 "loopback without --tokens (anyone who reaches it may submit and cancel)");
     tk_cli_fields(&cli, fields, sizeof fields / sizeof fields[0], &set);
@@ -143,7 +147,8 @@ int main(int argc, char **argv)
         tk_tokens_free(&tokens);
         return 2;
     }
-    printf("tightknotd: listening on http://%s:%u/ (workers %zu, store %s", api.bind,
+    printf("tightknotd: listening on %s://%s:%u/ (workers %zu, store %s", tk_api_scheme(server),
+           api.bind,
            tk_api_port(server), pool_cfg.workers, db);
     if (api.catalogue)
         printf(", catalogue %s with %zu knots", api.catalogue, tk_api_catalogue_size(server));

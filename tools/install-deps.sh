@@ -3,7 +3,7 @@
 set -eu
 packages="build-essential pkg-config check clang libsuitesparse-dev liblapack-dev
 libblas-dev libjansson-dev libmicrohttpd-dev libsqlite3-dev libcurl4-openssl-dev libgnutls28-dev
-wrk sqlite3 curl chromium firefox-esr xvfb"
+wrk sqlite3 curl openssl chromium firefox-esr xvfb"
 missing=""
 for p in $packages; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

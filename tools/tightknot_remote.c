@@ -62,6 +62,9 @@ const char tk_remote_help[] =
     "                 http://127.0.0.1:8080)\n"
     "  --token TOKEN  sent as 'Authorization: Bearer TOKEN' to a server with\n"
     "                 --tokens (default $TIGHTKNOT_TOKEN)\n"
+    "  --cacert FILE  the certificate (PEM) of the CA that signed an https\n"
+    "                 server's certificate, for a private CA (the system's CAs\n"
+    "                 otherwise); the server's name is always verified\n"
     "  --poll SECONDS how often to ask for progress (default 1)\n"
     "  --json         status: print the jobs as JSON, one per line\n"
     "\n"
@@ -83,6 +86,7 @@ typedef struct client {
     CURL *curl;
     char base[1024];
     const char *token; /* sent as a bearer token, or NULL */
+    const char *cacert; /* the CA that signed an https server's certificate, or NULL */
     char error[CURL_ERROR_SIZE];
     bool tty;
 } client;
@@ -142,6 +146,8 @@ static bool request(client *c, const char *method, const char *path, const char 
     curl_easy_setopt(h, CURLOPT_CONNECTTIMEOUT, 10L);
     curl_easy_setopt(h, CURLOPT_TIMEOUT, 120L);
     curl_easy_setopt(h, CURLOPT_NOSIGNAL, 1L);
+    if (c->cacert)
+        curl_easy_setopt(h, CURLOPT_CAINFO, c->cacert);
     struct curl_slist *headers = NULL;
     if (type) {
         char line[128];
@@ -869,6 +875,8 @@ int tk_remote_main(int argc, char **argv)
     tk_cli_flag(&cli, "json", 0, &json, NULL);
     tk_cli_text(&cli, "server", 0, "URL", &server, NULL);
     tk_cli_text(&cli, "token", 0, "TOKEN", &token, NULL);
+    const char *cacert = NULL;
+    tk_cli_text(&cli, "cacert", 0, "FILE", &cacert, NULL);
     tk_cli_text(&cli, "out", 0, "DIR", &a.out, NULL);
     tk_cli_fields(&cli, run_arg_fields, 2, &a);
     tk_cli_fields(&cli, tk_job_option_fields, tk_job_option_nfields, &job);
@@ -917,6 +925,7 @@ int tk_remote_main(int argc, char **argv)
     }
     snprintf(c.base, sizeof c.base, "%.*s", (int)blen, server);
     c.token = token && *token ? token : NULL;
+    c.cacert = cacert;
     if (c.token && strcspn(c.token, "\r\n") != strlen(c.token)) {
         fprintf(stderr, "tightknot remote: --token: a token is one line\n");
         return REMOTE_USAGE;
