@@ -123,8 +123,9 @@ int tk_cli_parse(tk_cli *c, int argc, char **argv, int *npos, tk_error *err)
         if (code == ':')
             return tk_error_set(err, TK_EINVAL, "option %s needs a value", args[optind - 1]);
         size_t k = code >= 256 ? (size_t)code - 256 : 0;
-        while (code < 256 && c->opt[k].letter != code)
+        while (code < 256 && k < c->n && c->opt[k].letter != code)
             k++;
+        assert(k < c->n); /* getopt returns only the letters it was given */
         if (apply(&c->opt[k], optarg, err))
             return TK_EINVAL;
     }
