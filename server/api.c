@@ -103,6 +103,17 @@ typedef struct request {
     bool admin;
 } request;
 
+/* With tokens every request names its client, but a read of health or of
+ * the page's files, and a preflight (browsers send no credentials). */
+static bool needs_token(const char *url, const char *method)
+{
+    if (!strcmp(method, "OPTIONS"))
+        return false;
+    bool api = !strncmp(url, "/v1/", 4) || !strcmp(url, "/v1") || !strcmp(url, "/metrics");
+    bool read = !strcmp(method, "GET") || !strcmp(method, "HEAD");
+    return !read || (api && strcmp(url, "/v1/health"));
+}
+
 /* Whether the client may see the job: without tokens anyone, else its
  * owner and admin names. */
 static bool visible(const request *rq, const json_t *doc)
@@ -794,13 +805,7 @@ static result handle(void *cls, conn *c, const char *url, const char *method,
         unsigned refused = boundary(a, c, why, sizeof why);
         if (refused) /* answered before any body is read */
             return problem(a, c, refused, NULL, NULL, "%s", why);
-        /* with tokens every request names its client, but health, the
-         * page's files and a preflight (browsers send no credentials) */
-        bool open = !strcmp(method, "OPTIONS") ||
-                    ((!strcmp(method, "GET") || !strcmp(method, "HEAD")) &&
-                     (!strcmp(url, "/v1/health") ||
-                      (strncmp(url, "/v1/", 4) && strcmp(url, "/v1") && strcmp(url, "/metrics"))));
-        if (a->cfg.tokens && !open &&
+        if (a->cfg.tokens && needs_token(url, method) &&
             !(rq->who = tk_tokens_check(a->cfg.tokens,
                                         MHD_lookup_connection_value(c, MHD_HEADER_KIND,
                                                                     MHD_HTTP_HEADER_AUTHORIZATION),

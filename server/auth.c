@@ -8,6 +8,7 @@
 #include <strings.h>
 
 #include <gnutls/crypto.h>
+#include <gnutls/gnutls.h>
 
 typedef struct entry {
     char name[64];
@@ -19,14 +20,6 @@ struct tk_tokens {
     entry *e;
     size_t n;
 };
-
-static int from_hex(const char *hex, unsigned char out[32])
-{
-    for (int i = 0; i < 32; i++)
-        if (sscanf(hex + 2 * i, "%2hhx", &out[i]) != 1)
-            return -1;
-    return strspn(hex, "0123456789abcdefABCDEF") == 64 && !hex[64] ? 0 : -1;
-}
 
 int tk_tokens_load(const char *path, tk_tokens **out, tk_error *err)
 {
@@ -47,9 +40,11 @@ int tk_tokens_load(const char *path, tk_tokens **out, tk_error *err)
         entry e = {.admin = k >= 3 && !strcmp(mark, "admin")};
         snprintf(e.name, sizeof e.name, "%s", name);
         bool hashed = !strncasecmp(token, "sha256:", 7);
+        size_t hash_size = sizeof e.hash;
         entry *grown = NULL;
         if (k < 2 || k > 3 || (k == 3 && !e.admin) || strlen(name) > 62 || strlen(token) > 510 ||
-            (hashed && from_hex(token + 7, e.hash)))
+            (hashed && (strlen(token + 7) != 64 ||
+                        gnutls_hex2bin(token + 7, 64, e.hash, &hash_size) || hash_size != 32)))
             rc = tk_error_set(err, TK_EPARSE, "%s:%ld: expected 'NAME TOKEN' or 'NAME "
                               "sha256:HEX' (64 hex digits; a name of at most 62 bytes, a token of at most 510), "
                               "then optionally 'admin'", path, no);

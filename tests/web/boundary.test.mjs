@@ -14,7 +14,10 @@
 
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
+import { mkdtempSync, writeFileSync } from 'node:fs';
 import { createServer } from 'node:http';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
 import { chromium } from 'playwright-core';
 import { startDaemon, api } from './daemon.mjs';
 
@@ -121,9 +124,6 @@ test('a name that is not the daemon\'s (DNS rebinding) gets 421, the page and th
 });
 
 test('with --tokens the page asks for a token once, keeps it for the session, and lists the jobs', async () => {
-    const { mkdtempSync, writeFileSync } = await import('node:fs');
-    const { tmpdir } = await import('node:os');
-    const { join } = await import('node:path');
     const dir = mkdtempSync(join(tmpdir(), 'tk-web-tokens-'));
     writeFileSync(join(dir, 'tokens'), 'ann ann-token-1\n');
     const d = await startDaemon(['--tokens', join(dir, 'tokens')]);
