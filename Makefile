@@ -40,7 +40,7 @@ endif
 CHECK_CFLAGS := $(shell pkg-config --cflags check 2>/dev/null)
 CHECK_LIBS := $(shell pkg-config --libs check 2>/dev/null)
 
-CPPFLAGS += -Iinclude -Icommon -Itests/support -I/usr/include/suitesparse -D_XOPEN_SOURCE=700
+CPPFLAGS += -Iinclude -Icommon -Itests/support -I/usr/include/suitesparse -I/usr/include/postgresql -D_XOPEN_SOURCE=700
 CFLAGS += -std=c11 $(OPT) -g -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
 	-Wmissing-prototypes -Wno-missing-field-initializers -MMD -MP $(SAN_FLAGS)
 LDFLAGS += $(SAN_FLAGS)
@@ -64,7 +64,7 @@ COMMON_LIB := $(BUILD)/libtkcommon.a
 SERVER_SRC := $(filter-out server/tightknotd.c,$(wildcard server/*.c))
 SERVER_OBJ := $(SERVER_SRC:%.c=$(BUILD)/%.o)
 SERVER_LIB := $(BUILD)/libtkserver.a
-SERVER_LIBS := -lmicrohttpd -ljansson -lsqlite3 -lgnutls
+SERVER_LIBS := -lmicrohttpd -ljansson -lsqlite3 -lpq -lgnutls
 DAEMON := $(BUILD)/tightknotd
 
 CLI_SRC := $(wildcard tools/tightknot*.c)

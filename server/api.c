@@ -412,8 +412,6 @@ static result cancel_job(tk_api *a, conn *c, int64_t id, const request *rq)
     rc = tk_pool_cancel(a->pool, id, &doc, &err);
     if (rc == TK_EINVAL && (rc = tk_store_delete(a->store, id, &err)) == TK_OK)
         return send_buffer(a, c, 204, NULL, NULL, 0, NULL); /* ended: it goes */
-    if (rc == TK_EBUSY)
-        return PROBLEM(a, c, 503, "%s", err.message);
     if (rc)
         return store_problem(a, c, rc, &err);
     /* a queued job is cancelled now (200), a running one within a step (202) */

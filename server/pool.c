@@ -5,6 +5,8 @@
 #include <math.h>
 #include <pthread.h>
 #include <sched.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,6 +23,7 @@ typedef struct slot {
     pthread_t thread;
     int64_t id;   /* the job it runs; 0: none */
     bool cancel;  /* its client asked to cancel it */
+    bool lost;    /* the store no longer has it held here (another daemon took it) */
     tk_run *run;  /* once set up */
     json_t *doc;  /* the job's document, less the figures below */
     const tk_job_options *opts;
@@ -34,6 +37,10 @@ struct tk_pool {
     tk_pool_config cfg;
     pthread_mutex_t lock; /* guards the slots, stopping, submitted and ready */
     pthread_cond_t wake;
+    pthread_t keeper;     /* renews the running jobs' claims (keeper) */
+    pthread_cond_t tick;  /* wakes the keeper when the pool halts */
+    bool keeping;
+    bool going;           /* workers claim jobs (tk_pool_go) */
     bool stopping, joined;
     unsigned long submitted;
     slot *slots;
@@ -197,6 +204,17 @@ static char *resume_text(const job_run *jr)
     return text;
 }
 
+/* The store no longer has the slot's job held here: its lease ran out
+ * and another daemon took it up, so this run stops without writing. */
+static void lose(tk_pool *p, slot *sl)
+{
+    pthread_mutex_lock(&p->lock);
+    sl->lost = true;
+    if (sl->run)
+        tk_run_cancel(sl->run);
+    pthread_mutex_unlock(&p->lock);
+}
+
 /* Writes the job's document, curve, contacts, history, resume point and
  * new frames in one transaction (NULL run: the document alone).  `end`
  * (or NULL) holds the fields of the job's end: they are written, and
@@ -236,6 +254,8 @@ static int flush(job_run *jr, const json_t *end, tk_error *err)
         jr->stored += jr->npending;
         while (jr->npending)
             drop_frame(jr);
+    } else if (rc == TK_ENOTFOUND) {
+        lose(jr->pool, jr->slot);
     }
     json_decref(doc);
     for (int k = 0; k < TK_PARTS; k++)
@@ -243,23 +263,26 @@ static int flush(job_run *jr, const json_t *end, tk_error *err)
     return rc;
 }
 
-/* Whether the worker should let go of its job: the pool halts, or (unless
- * the job has ended) it is cancelled. */
+/* Whether the worker should let go of its job: the pool halts, the job
+ * is held elsewhere now, or (unless it has ended) it is cancelled. */
 static bool letting_go(job_run *jr, bool ended)
 {
     pthread_mutex_lock(&jr->pool->lock);
-    bool go = jr->pool->stopping || (!ended && jr->slot->cancel);
+    bool go = jr->pool->stopping || jr->slot->lost || (!ended && jr->slot->cancel);
     pthread_mutex_unlock(&jr->pool->lock);
     return go;
 }
 
 /* Writes the job, pausing while the store refuses (see pool.h); `end` as
- * for flush (NULL while it runs). */
-static void store_job(job_run *jr, const json_t *end)
+ * for flush (NULL while it runs).  TK_OK once written; TK_ENOTFOUND when
+ * it is held elsewhere now; the store's failure when the pool halts or
+ * the job is cancelled before a write succeeds. */
+static int store_job(job_run *jr, const json_t *end)
 {
     tk_error err;
     bool paused = false, ended = end != NULL;
-    while (flush(jr, end, &err) != TK_OK && !letting_go(jr, ended)) {
+    int rc;
+    while ((rc = flush(jr, end, &err)) != TK_OK && !letting_go(jr, ended)) {
         pthread_mutex_lock(&jr->pool->lock);
         json_object_set_new(jr->slot->doc, "error",
                             json_sprintf("paused: storing the job failed, retrying every second:"
@@ -274,6 +297,7 @@ static void store_job(job_run *jr, const json_t *end)
     pthread_mutex_unlock(&jr->pool->lock);
     if (paused && !letting_go(jr, ended))
         flush(jr, end, &err); /* without the pause's message */
+    return rc;
 }
 
 static int on_step(const tk_step_report *r, void *user)
@@ -289,7 +313,7 @@ static int on_step(const tk_step_report *r, void *user)
     jr->slot->latest = *r;
     jr->slot->measured = true;
     jr->slot->frames = jr->stored + jr->npending;
-    bool go = p->stopping || jr->slot->cancel;
+    bool go = p->stopping || jr->slot->cancel || jr->slot->lost;
     pthread_mutex_unlock(&p->lock);
     if (!go && seconds_now() - jr->last_flush >= p->cfg.flush_seconds) {
         store_job(jr, NULL);
@@ -297,6 +321,30 @@ static int on_step(const tk_step_report *r, void *user)
         go = letting_go(jr, false); /* a paused store may have waited through either */
     }
     return go;
+}
+
+/* A line of the pool's log: the time (UTC, milliseconds), the job, what
+ * happened. */
+static void say(tk_pool *p, int64_t id, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static void say(tk_pool *p, int64_t id, const char *fmt, ...)
+{
+    if (!p->cfg.log)
+        return;
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    struct tm tm;
+    gmtime_r(&ts.tv_sec, &tm);
+    char line[256];
+    size_t n = strftime(line, sizeof line, "%Y-%m-%dT%H:%M:%S", &tm);
+    n += (size_t)snprintf(line + n, sizeof line - n, ".%03ldZ job %lld: ", ts.tv_nsec / 1000000,
+                          (long long)id);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line + n, sizeof line - n, fmt, ap);
+    va_end(ap);
+    fprintf(p->cfg.log, "tightknotd: %s\n", line); /* one call: lines never interleave */
+    fflush(p->cfg.log);
 }
 
 /* ---- setting a run up ---- */
@@ -411,6 +459,7 @@ static void run_job(slot *sl, int64_t id)
         if (sl->cancel || p->stopping)
             tk_run_cancel(jr.run);
         pthread_mutex_unlock(&p->lock);
+        say(p, id, "running from step %ld", tk_job_step(doc));
         /* the start stored at once: a crash from here resumes from it */
         jr.last_flush = seconds_now();
         on_step(tk_run_latest(jr.run), &jr);
@@ -420,6 +469,7 @@ static void run_job(slot *sl, int64_t id)
     }
     pthread_mutex_lock(&p->lock);
     sl->run = NULL;
+    bool lost = sl->lost;
     tk_job_state state = rc                         ? TK_JOB_FAILED
                          : why != TK_STOP_CANCELLED ? TK_JOB_DONE
                          : sl->cancel               ? TK_JOB_CANCELLED
@@ -432,11 +482,15 @@ static void run_job(slot *sl, int64_t id)
         json_object_set_new(end, "error", json_string(err.message));
     if (TK_JOB_FINAL(state))
         tk_job_stamp(end, "finished");
-    store_job(&jr, end);
+    int stored = lost ? TK_ENOTFOUND : store_job(&jr, end);
     pthread_mutex_lock(&p->lock);
     sl->id = 0;
     sl->doc = NULL;
     pthread_mutex_unlock(&p->lock);
+    say(p, id, "%s at step %ld", stored == TK_OK          ? tk_job_states[state]
+                                 : stored == TK_ENOTFOUND ? "taken up elsewhere: let go"
+                                                          : "let go unstored (the store fails)",
+        jr.last_step);
     json_decref(end);
     json_decref(doc);
     tk_run_free(&jr.run);
@@ -475,6 +529,10 @@ static void *worker(void *arg)
         unsigned long seen = p->submitted;
         if (p->stopping)
             break;
+        if (!p->going) {
+            pthread_cond_wait(&p->wake, &p->lock);
+            continue;
+        }
         pthread_mutex_unlock(&p->lock);
         int64_t id = 0;
         tk_error err;
@@ -493,6 +551,50 @@ static void *worker(void *arg)
     return NULL;
 }
 
+/* Renews the claims of the jobs running here every second (a lease is
+ * several seconds), and passes on what the store says: a cancellation
+ * asked through another daemon, or a job lost to one (its lease ran out
+ * while this daemon could not reach the store). */
+static void *keeper(void *arg)
+{
+    tk_pool *p = arg;
+    pthread_setname_np(pthread_self(), "tk-keeper");
+    int64_t *ids = calloc(p->nslots, sizeof *ids);
+    pthread_mutex_lock(&p->lock);
+    while (ids && !p->stopping) {
+        for (size_t i = 0; i < p->nslots; i++)
+            ids[i] = p->slots[i].lost ? 0 : p->slots[i].id;
+        pthread_mutex_unlock(&p->lock);
+        for (size_t i = 0; i < p->nslots; i++) {
+            bool cancel = false;
+            tk_error err;
+            int rc = ids[i] ? tk_store_renew(p->store, ids[i], &cancel, &err) : TK_EIO;
+            if (rc != TK_ENOTFOUND && !cancel)
+                continue; /* held (or the store out of reach: the next round tries again) */
+            pthread_mutex_lock(&p->lock);
+            slot *sl = &p->slots[i];
+            if (sl->id == ids[i]) { /* still the same job */
+                if (cancel)
+                    sl->cancel = true;
+                else
+                    sl->lost = true;
+                if (sl->run)
+                    tk_run_cancel(sl->run);
+            }
+            pthread_mutex_unlock(&p->lock);
+        }
+        struct timespec until;
+        clock_gettime(CLOCK_REALTIME, &until);
+        until.tv_sec += 1;
+        pthread_mutex_lock(&p->lock);
+        if (!p->stopping)
+            pthread_cond_timedwait(&p->tick, &p->lock, &until);
+    }
+    pthread_mutex_unlock(&p->lock);
+    free(ids);
+    return NULL;
+}
+
 int tk_pool_start(tk_store *store, const tk_pool_config *cfg, tk_pool **out, tk_error *err)
 {
     *out = NULL;
@@ -506,6 +608,7 @@ int tk_pool_start(tk_store *store, const tk_pool_config *cfg, tk_pool **out, tk_
     p->cfg.history = cfg->history > 2 ? cfg->history : 2; /* the first and the latest */
     pthread_mutex_init(&p->lock, NULL);
     pthread_cond_init(&p->wake, NULL);
+    pthread_cond_init(&p->tick, NULL);
     int rc = tk_store_requeue(store, err);
     for (size_t i = 0; !rc && i < cfg->workers; i++) {
         p->slots[i].pool = p;
@@ -519,10 +622,21 @@ int tk_pool_start(tk_store *store, const tk_pool_config *cfg, tk_pool **out, tk_
     while (p->ready < p->nslots)
         pthread_cond_wait(&p->wake, &p->lock);
     pthread_mutex_unlock(&p->lock);
+    if (!rc && pthread_create(&p->keeper, NULL, keeper, p))
+        rc = tk_error_set(err, TK_ENOMEM, "cannot start the thread that renews claims");
+    p->keeping = !rc;
     if (rc)
         tk_pool_free(&p);
     *out = p;
     return rc;
+}
+
+void tk_pool_go(tk_pool *p)
+{
+    pthread_mutex_lock(&p->lock);
+    p->going = true;
+    pthread_cond_broadcast(&p->wake);
+    pthread_mutex_unlock(&p->lock);
 }
 
 void tk_pool_halt(tk_pool *p)
@@ -534,9 +648,12 @@ void tk_pool_halt(tk_pool *p)
         if (p->slots[i].run)
             tk_run_cancel(p->slots[i].run);
     pthread_cond_broadcast(&p->wake);
+    pthread_cond_broadcast(&p->tick);
     pthread_mutex_unlock(&p->lock);
     for (size_t i = 0; !joined && i < p->nslots; i++)
         pthread_join(p->slots[i].thread, NULL);
+    if (!joined && p->keeping)
+        pthread_join(p->keeper, NULL);
 }
 
 void tk_pool_free(tk_pool **pp)
@@ -545,6 +662,7 @@ void tk_pool_free(tk_pool **pp)
         return;
     tk_pool_halt(*pp);
     pthread_cond_destroy(&(*pp)->wake);
+    pthread_cond_destroy(&(*pp)->tick);
     pthread_mutex_destroy(&(*pp)->lock);
     free((*pp)->slots);
     free(*pp);
@@ -587,36 +705,38 @@ json_t *tk_pool_live(tk_pool *p, int64_t id)
 int tk_pool_cancel(tk_pool *p, int64_t id, json_t **doc, tk_error *err)
 {
     *doc = NULL;
-    int rc = tk_store_cancel(p->store, id, err);
-    if (rc != TK_EINVAL)
-        return rc ? rc : tk_store_get(p->store, id, doc, err);
-    /* Not queued: running here, or ended.  A job claimed a moment ago is
-     * in the store as running before it is in its worker's slot. */
-    for (int tries = 0; tries < 1000; tries++) {
-        pthread_mutex_lock(&p->lock);
-        slot *sl = running(p, id);
-        if (sl) {
-            sl->cancel = true;
-            if (sl->run)
-                tk_run_cancel(sl->run);
-            *doc = current(sl);
-        }
-        pthread_mutex_unlock(&p->lock);
-        if (sl)
-            return TK_OK;
+    int rc = TK_EINVAL;
+    /* queued: cancelled now; running: marked, here or on another daemon
+     * (which learns it at its next renewal); between the two (claimed or
+     * queued again a moment ago), ask again */
+    for (int tries = 0; tries < 3 && rc == TK_EINVAL; tries++) {
+        rc = tk_store_cancel(p->store, id, err);
+        if (rc == TK_OK)
+            return tk_store_get(p->store, id, doc, err);
+        if (rc == TK_EINVAL)
+            rc = tk_store_stop(p->store, id, err);
+    }
+    if (rc == TK_EINVAL) { /* neither queued nor running: ended, or none */
         if ((rc = tk_store_get(p->store, id, doc, err)) != TK_OK)
             return rc;
         tk_job_state s = tk_job_state_in(*doc);
         json_decref(*doc);
         *doc = NULL;
-        if (TK_JOB_FINAL(s))
-            return tk_error_set(err, TK_EINVAL, "job %lld has ended (%s)", (long long)id,
-                                tk_job_states[s]);
-        if (s == TK_JOB_QUEUED && tk_store_cancel(p->store, id, err) == TK_OK)
-            return tk_store_get(p->store, id, doc, err);
-        nanosleep(&(struct timespec){0, 1000000}, NULL);
+        return tk_error_set(err, TK_EINVAL, "job %lld has ended (%s)", (long long)id,
+                            tk_job_states[s]);
     }
-    return tk_error_set(err, TK_EBUSY, "job %lld is being taken up: try again", (long long)id);
+    if (rc)
+        return rc;
+    pthread_mutex_lock(&p->lock);
+    slot *sl = running(p, id);
+    if (sl) { /* running here: it stops within a step */
+        sl->cancel = true;
+        if (sl->run)
+            tk_run_cancel(sl->run);
+        *doc = current(sl);
+    }
+    pthread_mutex_unlock(&p->lock);
+    return sl ? TK_OK : tk_store_get(p->store, id, doc, err);
 }
 
 void tk_pool_stats_get(tk_pool *p, tk_pool_stats *out)

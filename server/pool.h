@@ -12,13 +12,19 @@
  *   flush_seconds and at the end, in one transaction.  A start the engine
  *   refuses ends the job `failed` with the engine's message.
  * - Cancellation.  A queued job is cancelled in the store at once; a
- *   running one stops within a step and is stored `cancelled`.
+ *   running one stops within a step and is stored `cancelled`: at once
+ *   when it runs here, else when its daemon next renews its claim.
+ * - Claims.  A thread renews the claims of the jobs running here every
+ *   second (tk_store_renew): it learns of cancellations asked through
+ *   other daemons, and of jobs lost to them (a lease that ran out), which
+ *   stop without another write.
  * - Shutdown.  tk_pool_halt stops the running jobs within a step, stores
  *   them `queued` with their resume point, and joins the workers; the pool
  *   stays readable until tk_pool_free.
  * - Resume.  tk_pool_start queues again what the store holds as running
- *   (a stop or a crash); such a job goes on from its stored resume point
- *   (tk_run_resume), numbering its steps on.
+ *   (a stop or a crash; a shared store leaves that to the leases); such a
+ *   job goes on from its stored resume point (tk_run_resume), numbering
+ *   its steps on.
  * - Store failures.  When a write fails (a full disk) the job pauses: its
  *   document's error says why and the write is retried every second until
  *   it succeeds or the pool halts (the job then resumes at the next start).
@@ -28,6 +34,8 @@
  */
 #ifndef TK_SERVER_POOL_H
 #define TK_SERVER_POOL_H
+
+#include <stdio.h>
 
 #include "store.h"
 
@@ -41,6 +49,7 @@ typedef struct tk_pool_config {
     size_t max_vertices;  /* a run's vertex limit, after re-resolution */
     double flush_seconds; /* how often a running job is written */
     size_t history;       /* history entries kept per job (thinned beyond) */
+    FILE *log;            /* a line per job taken up and let go (NULL: none) */
 } tk_pool_config;
 
 /* What a job may keep of its frames: at most this many and this many
@@ -50,7 +59,10 @@ typedef struct tk_pool_config {
 
 typedef struct tk_pool tk_pool;
 
+/* Starts the workers, which take up jobs once tk_pool_go is called (so the
+ * daemon can say where it listens before the log's first job line). */
 int tk_pool_start(tk_store *store, const tk_pool_config *cfg, tk_pool **out, tk_error *err);
+void tk_pool_go(tk_pool *p);
 void tk_pool_halt(tk_pool *p);
 void tk_pool_free(tk_pool **p);
 

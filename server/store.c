@@ -1,325 +1,90 @@
-/* tightknot service: the SQLite job store (see store.h). */
+/* tightknot service: the job store's interface (see store.h): each call
+ * goes to the backend; what the backends share (the holder's name, the
+ * health of writes and reads) is kept here. */
 #include "store.h"
 
-#include <pthread.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/statvfs.h>
+#include <sys/random.h>
+#include <unistd.h>
 
-#include <sqlite3.h>
-
-#include "jsonmap.h"
-
-#define IDLE_MAX 32 /* connections kept for reuse; more are opened while needed */
-
-struct tk_store {
-    char *path;
-    pthread_mutex_t lock; /* guards what follows, never held over a statement */
-    sqlite3 *idle[IDLE_MAX];
-    size_t nidle;
-    char write_error[TK_ERROR_MESSAGE_SIZE]; /* the last write's failure, "" once one succeeds */
-    char damage[TK_ERROR_MESSAGE_SIZE];      /* the first damage a reader found */
-};
-
-/* the parts' columns, in tk_part's order */
-static const char *const part_columns[TK_PARTS] = {"input", "curve", "contacts", "history",
-                                                   "resume"};
-_Static_assert(TK_PARTS == 5, "tk_store_put writes the parts in one statement: name them there");
-
-static const char schema[] =
-    "CREATE TABLE IF NOT EXISTS jobs (id INTEGER PRIMARY KEY AUTOINCREMENT,"
-    " state TEXT NOT NULL, doc TEXT NOT NULL, input TEXT NOT NULL, curve TEXT, contacts TEXT,"
-    " history TEXT, resume TEXT);"
-    "CREATE INDEX IF NOT EXISTS jobs_by_state ON jobs (state, id);"
-    "CREATE TABLE IF NOT EXISTS frames (job INTEGER NOT NULL REFERENCES jobs (id) ON DELETE"
-    " CASCADE, seq INTEGER NOT NULL, step INTEGER NOT NULL, xyz BLOB NOT NULL, layout TEXT,"
-    " PRIMARY KEY (job, seq));";
-
-/* A store of the first version kept a job's fields in columns of their
- * own: each row becomes a document, in one transaction. */
-static const char upgrade[] =
-    "BEGIN; CREATE TABLE jobs_doc (id INTEGER PRIMARY KEY AUTOINCREMENT, state TEXT NOT NULL,"
-    " doc TEXT NOT NULL, input TEXT NOT NULL, curve TEXT, contacts TEXT, history TEXT,"
-    " resume TEXT);"
-    "INSERT INTO jobs_doc SELECT id, state, json_object('name', name, 'state', state,"
-    " 'options', json(options), 'progress', json_object('step', step, 'fraction', fraction),"
-    " 'step', step, 'seconds', seconds, 'ropelength', ropelength, 'length', length,"
-    " 'thickness', thickness, 'minrad', minrad, 'residual', residual, 'struts', struts,"
-    " 'kinks', kinks, 'step_size', step_size, 'rcond', rcond, 'violation', violation,"
-    " 'corrections', corrections, 'vertices', vertices, 'escapes', 0, 'components', components,"
-    " 'frames', frames, 'stop_reason', nullif(stop_reason, ''), 'error', nullif(error, ''),"
-    " 'invariants', json(invariants), 'created', strftime('%Y-%m-%dT%H:%M:%fZ', created,"
-    " 'unixepoch'), 'started', strftime('%Y-%m-%dT%H:%M:%fZ', started, 'unixepoch'),"
-    " 'finished', strftime('%Y-%m-%dT%H:%M:%fZ', finished, 'unixepoch')),"
-    " input, curve, contacts, history, resume FROM jobs;"
-    "DROP TABLE jobs; ALTER TABLE jobs_doc RENAME TO jobs; COMMIT;";
-
-static int failed(sqlite3 *db, tk_error *err, const char *what)
+void tk_store_init(tk_store *s, const tk_store_ops *ops)
 {
-    return tk_error_set(err, TK_EIO, "job store: %s: %s", what, sqlite3_errmsg(db));
+    s->ops = ops;
+    pthread_mutex_init(&s->lock, NULL);
+    char host[64] = "host";
+    gethostname(host, sizeof host - 1);
+    unsigned long long nonce = 0;
+    if (getrandom(&nonce, sizeof nonce, 0) != (ssize_t)sizeof nonce)
+        nonce = (unsigned long long)(uintptr_t)s ^ (unsigned long long)getpid();
+    snprintf(s->holder, sizeof s->holder, "%.63s:%ld:%016llx", host, (long)getpid(), nonce);
 }
 
-static sqlite3 *connect(const char *path, int flags, tk_error *err)
-{
-    sqlite3 *db = NULL;
-    int rc = sqlite3_open_v2(path, &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_NOMUTEX | flags, NULL);
-    /* NORMAL keeps every committed transaction across a crash of the
-     * process (kill -9), the failure the store must survive */
-    if (rc == SQLITE_OK)
-        rc = sqlite3_exec(db, "PRAGMA foreign_keys=ON; PRAGMA synchronous=NORMAL;", NULL, NULL,
-                          NULL);
-    if (rc != SQLITE_OK) {
-        tk_error_set(err, TK_EIO, "cannot set up the job store %s: %s", path,
-                     db ? sqlite3_errmsg(db) : sqlite3_errstr(rc));
-        sqlite3_close_v2(db);
-        return NULL;
-    }
-    sqlite3_busy_timeout(db, 10000);
-    return db;
-}
-
-/* A connection for this call; the lock only guards the list. */
-static sqlite3 *take(tk_store *s, tk_error *err)
-{
-    pthread_mutex_lock(&s->lock);
-    sqlite3 *db = s->nidle ? s->idle[--s->nidle] : NULL;
-    pthread_mutex_unlock(&s->lock);
-    return db ? db : connect(s->path, 0, err);
-}
-
-static void give(tk_store *s, sqlite3 *db)
-{
-    pthread_mutex_lock(&s->lock);
-    if (s->nidle < IDLE_MAX)
-        s->idle[s->nidle++] = db;
-    else
-        sqlite3_close_v2(db);
-    pthread_mutex_unlock(&s->lock);
-}
-
-/* A statement with its parameters bound by `types`: i int64, t text (NULL
- * binds null), b blob (pointer and int length). NULL when it fails. */
-static sqlite3_stmt *prepare(sqlite3 *db, const char *sql, const char *types, ...)
-{
-    sqlite3_stmt *st = NULL;
-    if (sqlite3_prepare_v2(db, sql, -1, &st, NULL) != SQLITE_OK)
-        return NULL;
-    va_list ap;
-    va_start(ap, types);
-    for (int i = 0; types[i]; i++) {
-        if (types[i] == 'i') {
-            sqlite3_bind_int64(st, i + 1, va_arg(ap, int64_t));
-        } else if (types[i] == 't') {
-            const char *t = va_arg(ap, const char *);
-            sqlite3_bind_text(st, i + 1, t, -1, SQLITE_TRANSIENT); /* NULL binds null */
-        } else {
-            const void *p = va_arg(ap, const void *);
-            sqlite3_bind_blob(st, i + 1, p, va_arg(ap, int), SQLITE_TRANSIENT);
-        }
-    }
-    va_end(ap);
-    return st;
-}
-
-/* Steps a statement that returns no row, and finalises it. */
-static bool done(sqlite3_stmt *st)
-{
-    bool ok = st && sqlite3_step(st) == SQLITE_DONE;
-    sqlite3_finalize(st);
-    return ok;
-}
-
-/* Notes a write's outcome for health; returns rc. */
-static int written(tk_store *s, int rc, const tk_error *err)
-{
-    pthread_mutex_lock(&s->lock);
-    snprintf(s->write_error, sizeof s->write_error, "%s", rc ? err->message : "");
-    pthread_mutex_unlock(&s->lock);
-    return rc;
-}
-
-int tk_store_open(const char *path, tk_store **out, tk_error *err)
+int tk_store_open(const char *where, double lease, tk_store **out, tk_error *err)
 {
     *out = NULL;
-    sqlite3 *db = connect(path, SQLITE_OPEN_CREATE, err);
-    if (!db)
-        return TK_EIO;
-    sqlite3_stmt *old = prepare(db, "SELECT options FROM jobs LIMIT 0", "");
-    bool first_version = old != NULL;
-    sqlite3_finalize(old);
-    char *message = NULL;
-    int rc = sqlite3_exec(db, "PRAGMA journal_mode=WAL;", NULL, NULL, &message);
-    if (rc == SQLITE_OK && first_version) {
-        /* columns that came later in the first version (an error: there) */
-        sqlite3_exec(db, "ALTER TABLE jobs ADD COLUMN invariants TEXT", NULL, NULL, NULL);
-        sqlite3_exec(db, "ALTER TABLE jobs ADD COLUMN resume TEXT", NULL, NULL, NULL);
-        sqlite3_exec(db, "ALTER TABLE frames ADD COLUMN layout TEXT", NULL, NULL, NULL);
-        rc = sqlite3_exec(db, "PRAGMA foreign_keys=OFF;", NULL, NULL, &message) ||
-             sqlite3_exec(db, upgrade, NULL, NULL, &message) ||
-             sqlite3_exec(db, "PRAGMA foreign_keys=ON;", NULL, NULL, &message);
-    }
-    if (rc == SQLITE_OK)
-        rc = sqlite3_exec(db, schema, NULL, NULL, &message);
-    tk_store *s = rc == SQLITE_OK ? calloc(1, sizeof *s) : NULL;
-    if (s && (s->path = strdup(path)) != NULL) {
-        pthread_mutex_init(&s->lock, NULL);
-        s->idle[s->nidle++] = db;
-        *out = s;
-        return TK_OK;
-    }
-    tk_error_set(err, rc ? TK_EIO : TK_ENOMEM, "cannot set up the job store %s: %s", path,
-                 rc ? (message ? message : sqlite3_errstr(rc)) : "out of memory");
-    sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL);
-    sqlite3_free(message);
-    sqlite3_close_v2(db);
-    free(s);
-    return rc ? TK_EIO : TK_ENOMEM;
+    if (!strncmp(where, "postgresql://", 13) || !strncmp(where, "postgres://", 11))
+        return tk_store_pg_open(where, lease, out, err);
+    return tk_store_sqlite_open(where, out, err);
 }
 
 void tk_store_close(tk_store **p)
 {
     if (!p || !*p)
         return;
-    while ((*p)->nidle)
-        sqlite3_close_v2((*p)->idle[--(*p)->nidle]);
     pthread_mutex_destroy(&(*p)->lock);
-    free((*p)->path);
-    free(*p);
+    (*p)->ops->close(*p);
     *p = NULL;
+}
+
+bool tk_store_shared(const tk_store *s)
+{
+    return s->shared;
+}
+
+const char *tk_store_holder(const tk_store *s)
+{
+    return s->holder;
+}
+
+/* Notes a write's outcome for health: a failure to reach or write the
+ * store (TK_EIO, TK_ENOMEM) until the next write that succeeds; answers
+ * about the job (busy, not found, not queued) are neither.  Returns rc. */
+static int written(tk_store *s, int rc, const tk_error *err)
+{
+    if (rc == TK_OK || rc == TK_EIO || rc == TK_ENOMEM) {
+        pthread_mutex_lock(&s->lock);
+        snprintf(s->write_error, sizeof s->write_error, "%s", rc ? err->message : "");
+        pthread_mutex_unlock(&s->lock);
+    }
+    return rc;
 }
 
 int tk_store_add(tk_store *s, json_t *doc, const char *input, size_t limit, size_t per_owner,
                  tk_error *err)
 {
-    sqlite3 *db = take(s, err);
-    if (!db)
-        return TK_EIO;
-    char *text = tk_json_dump(doc, false);
-    const char *owner = per_owner ? json_string_value(json_object_get(doc, "owner")) : NULL;
-    /* the limits and the insert in one statement: two requests cannot both
-     * take the last place */
-    sqlite3_stmt *st = prepare(db,
-                               "INSERT INTO jobs (state, doc, input) SELECT 'queued', ?1, ?2"
-                               " WHERE (SELECT count(*) FROM jobs WHERE state = 'queued') < ?3"
-                               " AND (?4 IS NULL OR (SELECT count(*) FROM jobs WHERE state IN"
-                               " ('queued', 'running') AND json_extract(doc, '$.owner') = ?4) < ?5)",
-                               "ttiti", text, input, (int64_t)limit, owner, (int64_t)per_owner);
-    int rc = text && done(st) ? TK_OK : failed(db, err, "adding a job");
-    free(text);
-    if (!rc && sqlite3_changes(db) == 0) { /* which limit: the queue's, or the owner's */
-        sqlite3_stmt *q = owner ? prepare(db, "SELECT count(*) FROM jobs WHERE state = 'queued'",
-                                          "") : NULL;
-        bool full = !q || (sqlite3_step(q) == SQLITE_ROW && sqlite3_column_int64(q, 0) >= (int64_t)limit);
-        sqlite3_finalize(q);
-        rc = full ? tk_error_set(err, TK_EBUSY, "the queue is full (%zu jobs waiting)", limit)
-                  : tk_error_set(err, TK_EBUSY, "'%.64s' has %zu jobs queued or running, as many "
-                                 "as a name may (--jobs-per-name)", owner, per_owner);
-    }
-    if (!rc)
-        json_object_set_new(doc, "id", json_integer(sqlite3_last_insert_rowid(db)));
-    give(s, db);
-    return rc == TK_EBUSY ? rc : written(s, rc, err);
+    return written(s, s->ops->add(s, doc, input, limit, per_owner, err), err);
 }
 
 int tk_store_put(tk_store *s, const json_t *doc, const char *const *parts,
                  const tk_frame *frames, size_t first, size_t nframes, tk_error *err)
 {
-    sqlite3 *db = take(s, err);
-    if (!db)
-        return written(s, TK_EIO, err);
-    int64_t id = tk_job_id(doc);
-    char *text = tk_json_dump(doc, false);
-    bool ok = text && sqlite3_exec(db, "BEGIN IMMEDIATE", NULL, NULL, NULL) == SQLITE_OK;
-    const char *const *p = parts ? parts : (const char *const[TK_PARTS]){NULL};
-    ok = ok && done(prepare(db,
-                            "UPDATE jobs SET state = ?, doc = ?, input = coalesce(?, input),"
-                            " curve = coalesce(?, curve), contacts = coalesce(?, contacts),"
-                            " history = coalesce(?, history), resume = coalesce(?, resume)"
-                            " WHERE id = ?",
-                            "ttttttti", tk_job_states[tk_job_state_in(doc)], text, p[0], p[1],
-                            p[2], p[3], p[4], id));
-    ok = ok && done(prepare(db, "DELETE FROM frames WHERE job = ? AND seq >= ?", "ii", id,
-                            (int64_t)first));
-    for (size_t i = 0; ok && i < nframes; i++)
-        ok = done(prepare(db, "INSERT INTO frames VALUES (?, ?, ?, ?, ?)", "iiibt", id,
-                          (int64_t)(first + i), (int64_t)frames[i].step, frames[i].xyz,
-                          (int)(frames[i].count * sizeof(double)), frames[i].layout));
-    ok = ok && sqlite3_exec(db, "COMMIT", NULL, NULL, NULL) == SQLITE_OK;
-    int rc = ok ? TK_OK : failed(db, err, "writing a job");
-    if (!ok)
-        sqlite3_exec(db, "ROLLBACK", NULL, NULL, NULL);
-    free(text);
-    give(s, db);
-    return written(s, rc, err);
-}
-
-/* Runs a query for one text column; *text NULL for a SQL null. */
-static int one_text(tk_store *s, sqlite3_stmt *st, sqlite3 *db, char **text, size_t *len,
-                    tk_error *err)
-{
-    *text = NULL;
-    int step = st ? sqlite3_step(st) : SQLITE_ERROR;
-    int rc = step == SQLITE_ROW ? TK_OK
-             : step == SQLITE_DONE ? tk_error_set(err, TK_ENOTFOUND, "no such job")
-                                   : failed(db, err, "reading a job");
-    const char *t = rc ? NULL : (const char *)sqlite3_column_text(st, 0);
-    size_t n = t ? (size_t)sqlite3_column_bytes(st, 0) : 0;
-    if (t && (*text = malloc(n + 1)) != NULL)
-        memcpy(*text, t, n + 1);
-    if (t && !*text)
-        rc = tk_error_set(err, TK_ENOMEM, "out of memory");
-    if (len)
-        *len = n;
-    sqlite3_finalize(st);
-    give(s, db);
-    return rc;
-}
-
-/* The document of a row (doc, id, state): the id and state are the
- * columns'.  NULL (TK_EIO in err, and the store reported damaged) when
- * it does not read back: SQLite checks its pages, not a row's bytes. */
-static json_t *row_doc(tk_store *s, sqlite3_stmt *st, tk_error *err)
-{
-    json_t *doc = json_loads((const char *)sqlite3_column_text(st, 0), 0, NULL);
-    if (json_is_object(doc)) {
-        json_object_set_new(doc, "id", json_integer(sqlite3_column_int64(st, 1)));
-        json_object_set_new(doc, "state", json_string((const char *)sqlite3_column_text(st, 2)));
-        return doc;
-    }
-    json_decref(doc);
-    tk_error_set(err, TK_EIO, "the stored document of job %lld does not read back",
-                 (long long)sqlite3_column_int64(st, 1));
-    tk_store_damage(s, err->message);
-    return NULL;
+    return written(s, s->ops->put(s, doc, parts, frames, first, nframes, err), err);
 }
 
 int tk_store_get(tk_store *s, int64_t id, json_t **doc, tk_error *err)
 {
     *doc = NULL;
-    sqlite3 *db = take(s, err);
-    if (!db)
-        return TK_EIO;
-    sqlite3_stmt *st = prepare(db, "SELECT doc, id, state FROM jobs WHERE id = ?", "i", (int64_t)id);
-    int step = st ? sqlite3_step(st) : SQLITE_ERROR;
-    int rc = step == SQLITE_DONE  ? tk_error_set(err, TK_ENOTFOUND, "there is no job %lld", (long long)id)
-             : step != SQLITE_ROW ? failed(db, err, "reading a job")
-             : !(*doc = row_doc(s, st, err)) ? TK_EIO
-                                              : TK_OK;
-    sqlite3_finalize(st);
-    give(s, db);
-    return rc;
+    return s->ops->get(s, id, doc, err);
 }
 
 int tk_store_part(tk_store *s, int64_t id, tk_part part, char **text, size_t *len, tk_error *err)
 {
-    sqlite3 *db = take(s, err);
-    if (!db)
-        return TK_EIO;
-    char sql[64];
-    snprintf(sql, sizeof sql, "SELECT %s FROM jobs WHERE id = ?", part_columns[part]);
-    return one_text(s, prepare(db, sql, "i", (int64_t)id), db, text, len, err);
+    *text = NULL;
+    if (len)
+        *len = 0;
+    return s->ops->part(s, id, part, text, len, err);
 }
 
 int tk_store_list(tk_store *s, int state, const char *owner, size_t offset, size_t limit,
@@ -327,92 +92,39 @@ int tk_store_list(tk_store *s, int state, const char *owner, size_t offset, size
 {
     *docs = json_array();
     *total = 0;
-    sqlite3 *db = take(s, err);
-    if (!db)
-        return TK_EIO;
-    const char *name = state >= 0 ? tk_job_states[state] : NULL;
-#define MATCHING " FROM jobs WHERE (?1 IS NULL OR state = ?1) AND (?2 IS NULL OR" \
-                 " json_extract(doc, '$.owner') = ?2)"
-    sqlite3_stmt *st = prepare(db, "SELECT count(*)" MATCHING, "tt", name, owner);
-    bool ok = st && sqlite3_step(st) == SQLITE_ROW;
-    *total = ok ? (size_t)sqlite3_column_int64(st, 0) : 0;
-    sqlite3_finalize(st);
-    st = ok ? prepare(db, "SELECT doc, id, state" MATCHING " ORDER BY id DESC LIMIT ?3 OFFSET ?4",
-                      "ttii", name, owner, (int64_t)limit, (int64_t)offset)
-            : NULL;
-    int step = SQLITE_ERROR;
-    json_t *doc = NULL;
-    while (st && (step = sqlite3_step(st)) == SQLITE_ROW && (doc = row_doc(s, st, err)) != NULL)
-        json_array_append_new(*docs, doc);
-    int rc = step == SQLITE_DONE ? TK_OK
-             : step == SQLITE_ROW ? TK_EIO
-                                  : failed(db, err, "listing jobs");
-    sqlite3_finalize(st);
-    give(s, db);
-    return rc;
-}
-
-/* Runs an UPDATE or DELETE on one job; TK_EINVAL with `why` when it
- * changes nothing. */
-static int change(tk_store *s, const char *sql, int64_t id, const char *why, tk_error *err)
-{
-    sqlite3 *db = take(s, err);
-    if (!db)
-        return TK_EIO;
-    int rc = done(prepare(db, sql, "i", id)) ? TK_OK : failed(db, err, "changing a job");
-    if (!rc && sqlite3_changes(db) == 0)
-        rc = tk_error_set(err, TK_EINVAL, "job %lld %s", (long long)id, why);
-    give(s, db);
-    return rc == TK_EINVAL ? rc : written(s, rc, err);
-}
-
-int tk_store_cancel(tk_store *s, int64_t id, tk_error *err)
-{
-    return change(s,
-                  "UPDATE jobs SET state = 'cancelled', doc = json_set(doc, '$.stop_reason',"
-                  " 'cancelled', '$.finished', strftime('%Y-%m-%dT%H:%M:%fZ')) WHERE id = ? AND"
-                  " state = 'queued'",
-                  id, "is not queued", err);
-}
-
-int tk_store_delete(tk_store *s, int64_t id, tk_error *err)
-{
-    return change(s,
-                  "DELETE FROM jobs WHERE id = ? AND state IN ('done', 'failed', 'cancelled')",
-                  id, "has not ended", err);
-}
-
-int tk_store_requeue(tk_store *s, tk_error *err)
-{
-    sqlite3 *db = take(s, err);
-    if (!db)
-        return TK_EIO;
-    int rc = done(prepare(db, "UPDATE jobs SET state = 'queued' WHERE state = 'running'", ""))
-                 ? TK_OK
-                 : failed(db, err, "queueing unfinished jobs");
-    give(s, db);
-    return rc;
+    return s->ops->list(s, state, owner, offset, limit, docs, total, err);
 }
 
 int tk_store_claim(tk_store *s, int64_t *id, tk_error *err)
 {
-    sqlite3 *db = take(s, err);
-    if (!db)
-        return TK_EIO;
-    sqlite3_stmt *st = prepare(db,
-                               "UPDATE jobs SET state = 'running' WHERE id = (SELECT min(id) FROM"
-                               " jobs WHERE state = 'queued') RETURNING id",
-                               "");
-    int step = st ? sqlite3_step(st) : SQLITE_ERROR;
-    *id = step == SQLITE_ROW ? sqlite3_column_int64(st, 0) : 0;
-    if (step == SQLITE_ROW)
-        step = sqlite3_step(st);
-    sqlite3_finalize(st);
-    int rc = step != SQLITE_DONE ? failed(db, err, "claiming a job")
-             : *id              ? TK_OK
-                                : tk_error_set(err, TK_ENOTFOUND, "no job is queued");
-    give(s, db);
-    return rc == TK_ENOTFOUND ? rc : written(s, rc, err);
+    *id = 0;
+    return written(s, s->ops->claim(s, id, err), err);
+}
+
+int tk_store_renew(tk_store *s, int64_t id, bool *cancel, tk_error *err)
+{
+    *cancel = false;
+    return written(s, s->ops->renew(s, id, cancel, err), err);
+}
+
+int tk_store_requeue(tk_store *s, tk_error *err)
+{
+    return written(s, s->ops->requeue(s, err), err);
+}
+
+int tk_store_cancel(tk_store *s, int64_t id, tk_error *err)
+{
+    return written(s, s->ops->cancel(s, id, err), err);
+}
+
+int tk_store_stop(tk_store *s, int64_t id, tk_error *err)
+{
+    return written(s, s->ops->stop(s, id, err), err);
+}
+
+int tk_store_delete(tk_store *s, int64_t id, tk_error *err)
+{
+    return written(s, s->ops->remove(s, id, err), err);
 }
 
 int tk_store_frames(tk_store *s, int64_t id, size_t offset, size_t limit, tk_frame **out,
@@ -420,31 +132,9 @@ int tk_store_frames(tk_store *s, int64_t id, size_t offset, size_t limit, tk_fra
 {
     *out = calloc(limit ? limit : 1, sizeof **out);
     *n = 0;
-    sqlite3 *db = *out ? take(s, err) : NULL;
-    if (!db)
-        return *out ? TK_EIO : tk_error_set(err, TK_ENOMEM, "out of memory");
-    sqlite3_stmt *st = prepare(db,
-                               "SELECT step, xyz, layout FROM frames WHERE job = ? AND seq >= ?"
-                               " ORDER BY seq LIMIT ?",
-                               "iii", (int64_t)id, (int64_t)offset, (int64_t)limit);
-    int step = SQLITE_ERROR;
-    while (st && (step = sqlite3_step(st)) == SQLITE_ROW && *n < limit) {
-        tk_frame *f = &(*out)[(*n)++];
-        size_t bytes = (size_t)sqlite3_column_bytes(st, 1);
-        const char *layout = (const char *)sqlite3_column_text(st, 2);
-        f->step = (long)sqlite3_column_int64(st, 0);
-        f->count = bytes / sizeof(double);
-        f->xyz = malloc(bytes + 1);
-        f->layout = layout ? strdup(layout) : NULL;
-        if (f->xyz)
-            memcpy(f->xyz, sqlite3_column_blob(st, 1), f->count * sizeof(double));
-        else
-            step = SQLITE_NOMEM;
-    }
-    sqlite3_finalize(st);
-    int rc = step == SQLITE_DONE ? TK_OK : failed(db, err, "reading frames");
-    give(s, db);
-    return rc;
+    if (!*out)
+        return tk_error_set(err, TK_ENOMEM, "out of memory");
+    return s->ops->frames(s, id, offset, limit, out, n, err);
 }
 
 void tk_frames_free(tk_frame *f, size_t n)
@@ -459,18 +149,7 @@ void tk_frames_free(tk_frame *f, size_t n)
 int tk_store_counts(tk_store *s, size_t counts[TK_JOB_STATES], tk_error *err)
 {
     memset(counts, 0, TK_JOB_STATES * sizeof *counts);
-    sqlite3 *db = take(s, err);
-    if (!db)
-        return TK_EIO;
-    sqlite3_stmt *st = prepare(db, "SELECT state, count(*) FROM jobs GROUP BY state", "");
-    int step = SQLITE_ERROR, k;
-    while (st && (step = sqlite3_step(st)) == SQLITE_ROW)
-        if ((k = tk_job_state_of((const char *)sqlite3_column_text(st, 0))) >= 0)
-            counts[k] = (size_t)sqlite3_column_int64(st, 1);
-    sqlite3_finalize(st);
-    int rc = step == SQLITE_DONE ? TK_OK : failed(db, err, "counting jobs");
-    give(s, db);
-    return rc;
+    return s->ops->counts(s, counts, err);
 }
 
 void tk_store_damage(tk_store *s, const char *what)
@@ -483,24 +162,16 @@ void tk_store_damage(tk_store *s, const char *what)
 
 bool tk_store_health(tk_store *s, char *reason, size_t size)
 {
-    char dir[4096];
-    const char *slash = strrchr(s->path, '/');
-    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - s->path) + 1 : 1, slash ? s->path : ".");
-    struct statvfs fs;
-    bool known = statvfs(dir, &fs) == 0;
-    double room = known ? (double)fs.f_bavail * (double)fs.f_frsize : 1e300;
+    reason[0] = '\0';
     pthread_mutex_lock(&s->lock);
     if (s->damage[0])
         snprintf(reason, size, "the job store is damaged: %s", s->damage);
-    else if (known && (fs.f_flag & ST_RDONLY))
-        snprintf(reason, size, "the job store's file system is read-only: jobs cannot be stored");
-    else if (room < 64.0 * 1024.0) /* a save (curve, frames) needs more than a page or two */
-        snprintf(reason, size, "the job store's file system is full (%.0f KiB free): jobs cannot "
-                 "be stored", room / 1024.0);
-    else if (s->write_error[0])
+    pthread_mutex_unlock(&s->lock);
+    if (!reason[0])
+        s->ops->room(s, reason, size);
+    pthread_mutex_lock(&s->lock);
+    if (!reason[0] && s->write_error[0])
         snprintf(reason, size, "the last write to the job store failed: %s", s->write_error);
-    else
-        reason[0] = '\0';
     pthread_mutex_unlock(&s->lock);
     if (reason[0])
         return false;

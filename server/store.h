@@ -2,13 +2,23 @@
  *
  * A job is a row of a few fixed columns: its id, its state (the queue is
  * the store: claiming takes the oldest queued job), its document
- * (job.h) and its large parts as text, and its frames in a table of their
- * own.  This backend is one SQLite file in WAL mode, each thread on a
- * connection of its own, so a reader never waits for a writer.
+ * (job.h), its large parts, who holds it while it runs, and its frames in
+ * a table of their own.  Two backends:
+ * - SQLite (store_sqlite.c): one file in WAL mode for one daemon, each
+ *   thread on a connection of its own, so a reader never waits for a
+ *   writer;
+ * - PostgreSQL (store_pg.c): one database shared by any number of daemons.
+ *   A claim takes the oldest job that is queued or whose holder's lease
+ *   ran out, in one statement (FOR UPDATE SKIP LOCKED), so no job runs
+ *   twice at once; the holder renews the lease (tk_store_renew) and a
+ *   daemon that dies loses its jobs to the others when it runs out.
+ * Writes to a running job (tk_store_put, tk_store_renew) succeed only for
+ * its holder, so a daemon that lost a job can no longer change it.
  */
 #ifndef TK_SERVER_STORE_H
 #define TK_SERVER_STORE_H
 
+#include <pthread.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -34,9 +44,17 @@ typedef struct tk_frame {
 
 typedef struct tk_store tk_store;
 
-/* Opens the file, creating it and its tables when missing. */
-int tk_store_open(const char *path, tk_store **out, tk_error *err);
+/* Opens the store `where` names, creating its tables when missing: a
+ * postgresql:// (or postgres://) URI, or else a SQLite file.  `lease`:
+ * the seconds a claim lasts unrenewed (PostgreSQL only). */
+int tk_store_open(const char *where, double lease, tk_store **out, tk_error *err);
 void tk_store_close(tk_store **p);
+
+/* Whether other daemons may share the store (PostgreSQL). */
+bool tk_store_shared(const tk_store *s);
+
+/* Who claims jobs through this store: "host:pid:random", unique. */
+const char *tk_store_holder(const tk_store *s);
 
 /* Stores a new queued job (doc gets its id) with its input, unless
  * `limit` jobs are queued already, or (per_owner > 0) its owner (the
@@ -45,9 +63,10 @@ void tk_store_close(tk_store **p);
 int tk_store_add(tk_store *s, json_t *doc, const char *input, size_t limit, size_t per_owner,
                  tk_error *err);
 
-/* Writes a job: its document (and state from it), the parts that are not
- * NULL, and its frames from number `first` on (later ones dropped), in
- * one transaction. */
+/* Writes a job this store holds: its document (and state from it; a state
+ * other than running lets go of it), the parts that are not NULL, and its
+ * frames from number `first` on (later ones dropped), in one transaction.
+ * TK_ENOTFOUND when the job is not held here (any more). */
 int tk_store_put(tk_store *s, const json_t *doc, const char *const *parts,
                  const tk_frame *frames, size_t first, size_t nframes, tk_error *err);
 
@@ -62,14 +81,25 @@ int tk_store_part(tk_store *s, int64_t id, tk_part part, char **text, size_t *le
 int tk_store_list(tk_store *s, int state, const char *owner, size_t offset, size_t limit,
                   json_t **docs, size_t *total, tk_error *err);
 
-/* The oldest queued job becomes running: its id; TK_ENOTFOUND when none. */
+/* The oldest queued job (PostgreSQL: or running with its lease run out)
+ * becomes running, held here: its id; TK_ENOTFOUND when none. */
 int tk_store_claim(tk_store *s, int64_t *id, tk_error *err);
 
-/* Running jobs become queued again (at start: what a stop or a crash left). */
+/* Keeps a running job held here (PostgreSQL: its lease starts again);
+ * *cancel when a client asked to cancel it (tk_store_stop).  TK_ENOTFOUND
+ * when it is no longer held here. */
+int tk_store_renew(tk_store *s, int64_t id, bool *cancel, tk_error *err);
+
+/* At start: SQLite's running jobs (what a stop or a crash left) become
+ * queued again.  PostgreSQL leaves them to their leases. */
 int tk_store_requeue(tk_store *s, tk_error *err);
 
 /* A queued job becomes cancelled; TK_EINVAL when it is not queued. */
 int tk_store_cancel(tk_store *s, int64_t id, tk_error *err);
+
+/* A running job is marked to be cancelled: its holder learns it at its
+ * next renewal.  TK_EINVAL when it is not running. */
+int tk_store_stop(tk_store *s, int64_t id, tk_error *err);
 
 /* Removes an ended job; TK_EINVAL when it has not ended. */
 int tk_store_delete(tk_store *s, int64_t id, tk_error *err);
@@ -88,5 +118,46 @@ bool tk_store_health(tk_store *s, char *reason, size_t size);
 /* A stored text did not read back as written (SQLite checks pages, not
  * the bytes in a row): health reports it until restart. */
 void tk_store_damage(tk_store *s, const char *what);
+
+/* ---- for the backends ---- */
+
+/* A backend's operations, each as its tk_store_ function says; `room`
+ * says why jobs cannot be stored where the backend can tell (a full or
+ * read-only file system), else leaves reason empty. */
+typedef struct tk_store_ops {
+    int (*add)(tk_store *, json_t *, const char *, size_t, size_t, tk_error *);
+    int (*put)(tk_store *, const json_t *, const char *const *, const tk_frame *, size_t, size_t,
+               tk_error *);
+    int (*get)(tk_store *, int64_t, json_t **, tk_error *);
+    int (*part)(tk_store *, int64_t, tk_part, char **, size_t *, tk_error *);
+    int (*list)(tk_store *, int, const char *, size_t, size_t, json_t **, size_t *, tk_error *);
+    int (*claim)(tk_store *, int64_t *, tk_error *);
+    int (*renew)(tk_store *, int64_t, bool *, tk_error *);
+    int (*requeue)(tk_store *, tk_error *);
+    int (*cancel)(tk_store *, int64_t, tk_error *);
+    int (*stop)(tk_store *, int64_t, tk_error *);
+    int (*remove)(tk_store *, int64_t, tk_error *);
+    int (*frames)(tk_store *, int64_t, size_t, size_t, tk_frame **, size_t *, tk_error *);
+    int (*counts)(tk_store *, size_t[TK_JOB_STATES], tk_error *);
+    void (*room)(tk_store *, char *, size_t);
+    void (*close)(tk_store *);
+} tk_store_ops;
+
+/* What every backend's store begins with. */
+struct tk_store {
+    const tk_store_ops *ops;
+    bool shared;
+    double lease;
+    char holder[96];
+    pthread_mutex_t lock;                    /* guards the two texts that follow */
+    char write_error[TK_ERROR_MESSAGE_SIZE]; /* the last write's failure, "" once one succeeds */
+    char damage[TK_ERROR_MESSAGE_SIZE];      /* the first damage a reader found */
+};
+
+/* The backends' openers (tk_store_open chooses); tk_store_init sets up
+ * the common part. */
+int tk_store_sqlite_open(const char *path, tk_store **out, tk_error *err);
+int tk_store_pg_open(const char *uri, double lease, tk_store **out, tk_error *err);
+void tk_store_init(tk_store *s, const tk_store_ops *ops);
 
 #endif

@@ -17,6 +17,7 @@
 typedef struct settings {
     tk_api_config api;
     tk_pool_config pool;
+    double lease;
 } settings;
 #define ROW(path, fld, kind, dflt, lo, hi, hlp)                                                \
     TK_FIELD_ROW(settings, path, fld, kind, dflt, lo, hi, #fld, hlp)
@@ -38,6 +39,9 @@ static const tk_field fields[] = {
         "open connections from one client address"),
     ROW(api.timeout, timeout, SIZE, 10, 1, 3600, "seconds a silent connection is kept open"),
     ROW(api.threads, http_threads, SIZE, 2, 1, 64, "threads answering requests"),
+    ROW(lease, lease, REAL, 30, 3, 3600,
+        "with a PostgreSQL --db: seconds after which the jobs of a daemon that stopped "
+        "renewing them (one that died) are taken up by the others"),
 };
 
 int main(int argc, char **argv)
@@ -49,8 +53,9 @@ int main(int argc, char **argv)
     tk_cli cli = {.n = 0};
     tk_cli_text(&cli, "bind", 0, "ADDR", &set.api.bind, "IPv4 address to listen on (default "
                 "127.0.0.1)");
-    tk_cli_text(&cli, "db", 0, "FILE", &db, "job store (default var/tightknot.db; its "
-                "directory is created when missing)");
+    tk_cli_text(&cli, "db", 0, "STORE", &db, "job store: a SQLite file (default "
+                "var/tightknot.db; its directory is created when missing), or "
+                "postgresql://USER@HOST/DB, one database that any number of daemons share");
     tk_cli_text(&cli, "catalogue", 0, "DIR", &set.api.catalogue, "offer DIR's *.vect files at "
                 "/v1/catalogue");
     tk_cli_text(&cli, "web", 0, "DIR", &set.api.web, "serve the page's files from DIR at /");
@@ -84,12 +89,15 @@ int main(int argc, char **argv)
         printf("usage: tightknotd [options]\n\n"
                "The tightknot service: tightens knots and links given as Geomview VECT\n"
                "over an HTTP/JSON API (see openapi.yaml), one job per knot, on a pool of\n"
-               "worker threads; jobs are kept in a SQLite file and survive restarts.\n\n"
+               "worker threads; jobs are kept in a SQLite file, or in a PostgreSQL\n"
+               "database shared by several daemons, and survive restarts.\n\n"
                "options:\n");
         tk_cli_help(&cli, stdout);
-        printf("\nOn start it prints the URL it listens on.  SIGINT or SIGTERM stops it\n"
-               "within a few seconds; running jobs are stored and resume at the next\n"
-               "start, as do jobs left by a crash.\n");
+        printf("\nOn start it prints the URL it listens on, then a line for each job it\n"
+               "takes up or lets go.  SIGINT or SIGTERM stops it within a few seconds;\n"
+               "running jobs are stored and resume at the next start (with PostgreSQL:\n"
+               "on any daemon), as do jobs left by a crash (with PostgreSQL: once their\n"
+               "lease runs out).\n");
         return 0;
     }
     if (npos > 0)
@@ -128,18 +136,20 @@ int main(int argc, char **argv)
     sigaddset(&stop, SIGTERM);
     pthread_sigmask(SIG_BLOCK, &stop, NULL);
 
+    bool postgres = !strncmp(db, "postgresql://", 13) || !strncmp(db, "postgres://", 11);
     char dir[PATH_MAX];
     const char *slash = strrchr(db, '/');
     snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - db) : 0, db);
-    if (slash && slash != db)
+    if (!postgres && slash && slash != db)
         mkdir(dir, 0777); /* one level, as var/ is */
+    pool_cfg.log = stdout;
     tk_tokens *tokens = NULL;
     tk_store *store = NULL;
     tk_pool *pool = NULL;
     tk_api *server = NULL;
     int rc = tokens_file ? tk_tokens_load(tokens_file, &tokens, &err) : TK_OK;
     api.tokens = tokens;
-    if (rc || tk_store_open(db, &store, &err) || tk_pool_start(store, &pool_cfg, &pool, &err) ||
+    if (rc || tk_store_open(db, set.lease, &store, &err) || tk_pool_start(store, &pool_cfg, &pool, &err) ||
         tk_api_start(&api, pool, store, &server, &err)) {
         fprintf(stderr, "tightknotd: %s\n", err.message);
         tk_pool_free(&pool);
@@ -147,13 +157,16 @@ int main(int argc, char **argv)
         tk_tokens_free(&tokens);
         return 2;
     }
+    /* a URI may hold a password: only what kind of store it is */
     printf("tightknotd: listening on %s://%s:%u/ (workers %zu, store %s", tk_api_scheme(server),
-           api.bind,
-           tk_api_port(server), pool_cfg.workers, db);
+           api.bind, tk_api_port(server), pool_cfg.workers, postgres ? "PostgreSQL" : db);
+    if (postgres)
+        printf(" as %s, lease %g s", tk_store_holder(store), set.lease);
     if (api.catalogue)
         printf(", catalogue %s with %zu knots", api.catalogue, tk_api_catalogue_size(server));
     printf(")\n");
     fflush(stdout);
+    tk_pool_go(pool);
     int sig = 0;
     sigwait(&stop, &sig);
     printf("tightknotd: %s: storing running jobs and stopping\n",

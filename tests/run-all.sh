@@ -19,7 +19,19 @@ passed=0
 failed=0
 skipped=0
 log=$(mktemp)
-trap 'rm -f "$log"' EXIT
+# A PostgreSQL server of the tests' own (tests/pg.sh, in a directory the
+# postgres user can reach): the store's tests on PostgreSQL, the service's
+# suite on it, and several daemons sharing one database.
+pgdir=$(mktemp -d /tmp/tk-pg-XXXXXX)
+chmod 755 "$pgdir"
+trap 'rm -f "$log"; ./tests/pg.sh stop "$pgdir/server" 2>/dev/null; rm -rf "$pgdir"' EXIT
+TK_PG_URL=$(./tests/pg.sh start "$pgdir/server" 2>"$log")
+case $? in
+0) echo "postgresql: a server of the tests' own at $TK_PG_URL" ;;
+3) TK_PG_URL=""; skipped=$((skipped + 1)); echo "SKIP postgresql: $(cat "$log")" ;;
+*) TK_PG_URL=""; failed=$((failed + 1)); echo "FAIL postgresql: the tests' server did not start"; cat "$log" ;;
+esac
+export TK_PG_URL
 
 # Check's summary line: "100%: Checks: 7, Failures: 0, Errors: 0"
 count_check() {
@@ -62,6 +74,10 @@ done
 # sanitizer's.
 if [ "$unit_only" -eq 0 ]; then
     suites="tests/cli-*.sh tests/*/run.sh"
+    # the service's suite once more with every daemon's store on
+    # PostgreSQL: the files whose jobs are stored, restarted and shared
+    # (the others poke the SQLite file or never store a job)
+    [ -n "$TK_PG_URL" ] && suites="$suites pg:tests/service/run.sh"
     [ -n "$asan" ] && [ -x "$asan/tightknotd" ] && suites="$suites asan:tests/service/run.sh"
     # and against the thread sanitizer's daemon, every file but the two
     # slowest (kill -9 ten times, a file system filling up: no thread
@@ -70,17 +86,24 @@ if [ "$unit_only" -eq 0 ]; then
     [ -x "$tsan/tightknotd" ] && suites="$suites tsan:tests/service/run.sh"
     for t in $suites; do
         dir=$build
-        only=""
+        store=sqlite
+        # every file but those of the PostgreSQL pass alone
+        only=$(ls tests/service/*.test.mjs | grep -v -e cluster | tr '\n' ' ')
         case "$t" in
+        pg:*)
+            t=${t#pg:}; store=postgresql
+            only=$(ls tests/service/*.test.mjs | grep -e cluster -e queue -e restart -e results \
+                -e tokens -e workers | tr '\n' ' ')
+            ;;
         asan:*) dir=$asan; t=${t#asan:} ;;
         tsan:*)
             dir=$tsan; t=${t#tsan:}
-            only=$(ls tests/service/*.test.mjs | grep -v -e chaos -e store | tr '\n' ' ')
+            only=$(ls tests/service/*.test.mjs | grep -v -e chaos -e store -e cluster | tr '\n' ' ')
             ;;
         esac
         [ -f "$t" ] || continue
         TK_BUILD=$dir TK_ASAN_BUILD=$asan TK_DAEMON=$dir/tightknotd TK_CLI=$dir/tightknot \
-            TK_WEB=$dir/web TK_SERVICE_TESTS=$only sh "$t" >"$log" 2>&1
+            TK_WEB=$dir/web TK_SERVICE_TESTS=$only TK_STORE=$store sh "$t" >"$log" 2>&1
         line=$(grep -E '^[a-z-]+: [0-9]+ passed, [0-9]+ failed' "$log" | tail -n 1)
         if [ -z "$line" ]; then
             failed=$((failed + 1)); echo "FAIL $t: no summary"; tail -n 20 "$log"; continue
@@ -89,7 +112,7 @@ if [ "$unit_only" -eq 0 ]; then
         f=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\2/')
         k=$(echo "$line" | sed -nE 's/.* ([0-9]+) skipped.*/\1/p')
         passed=$((passed + p)); failed=$((failed + f)); skipped=$((skipped + ${k:-0}))
-        echo "$t ($dir): $line"
+        echo "$t ($dir, $store): $line"
         grep -E '^SKIP ' "$log"
         [ "$f" -eq 0 ] || grep -E '^FAIL|^not ok|^# fail|Error' "$log" | head -n 40
         # a ThreadSanitizer report: where the two accesses were

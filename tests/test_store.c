@@ -1,16 +1,22 @@
-/* Tests for the SQLite job store (server/store.c): a job's document,
- * parts and frames read back the same after the file is opened again;
- * listing is newest first with a filter and pages; the queue is the store
- * (claims take the oldest queued job, each exactly once, from many
- * threads; the limit holds); cancelling, deleting and queueing again
- * change only the jobs they may; a reader never waits for a writer; a
- * store of the first version becomes documents and keeps its jobs. */
+/* Tests for the job store (server/store.c), each backend: a job's
+ * document, parts and frames read back the same after the store is opened
+ * again; listing is newest first with a filter and pages; the queue is the
+ * store (claims take the oldest queued job, each exactly once, from many
+ * threads; the limits hold); cancelling, deleting and queueing again
+ * change only the jobs they may; a running job is written only by its
+ * holder, which learns of a cancellation asked elsewhere.  SQLite: a
+ * reader never waits for a writer; a store of the first version becomes
+ * documents and keeps its jobs.  PostgreSQL (on the server $TK_PG_URL
+ * names, tests/pg.sh; a database of its own per test): a claim whose
+ * lease ran out goes to another store. */
 #include <check.h>
+#include <libpq-fe.h>
 #include <pthread.h>
 #include <sqlite3.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "jsonmap.h"
@@ -19,12 +25,49 @@
 
 static char dir[64];
 static char path[128];
+static char where[512]; /* what tk_store_open is given: path, or a database's URI */
+static bool shared;     /* the PostgreSQL backend */
 
 static void setup(void)
 {
     snprintf(dir, sizeof dir, "/tmp/tk-store-XXXXXX");
     ck_assert_ptr_nonnull(mkdtemp(dir));
     snprintf(path, sizeof path, "%s/jobs.db", dir);
+    snprintf(where, sizeof where, "%s", path);
+    shared = false;
+}
+
+/* Runs one statement on the tests' PostgreSQL server. */
+static void pg_exec(const char *sql)
+{
+    PGconn *c = PQconnectdb(getenv("TK_PG_URL"));
+    ck_assert_msg(PQstatus(c) == CONNECTION_OK, "%s", PQerrorMessage(c));
+    PGresult *r = PQexec(c, sql);
+    ck_assert_msg(PQresultStatus(r) == PGRES_COMMAND_OK, "%s: %s", sql, PQerrorMessage(c));
+    PQclear(r);
+    PQfinish(c);
+}
+
+static char database[64];
+
+static void pg_setup(void)
+{
+    static int n;
+    snprintf(database, sizeof database, "tk_store_%ld_%d", (long)getpid(), ++n);
+    char sql[128];
+    snprintf(sql, sizeof sql, "CREATE DATABASE %s", database);
+    pg_exec(sql);
+    const char *url = getenv("TK_PG_URL");
+    const char *slash = strrchr(url, '/');
+    snprintf(where, sizeof where, "%.*s/%s", (int)(slash - url), url, database);
+    shared = true;
+}
+
+static void pg_teardown(void)
+{
+    char sql[128];
+    snprintf(sql, sizeof sql, "DROP DATABASE %s WITH (FORCE)", database);
+    pg_exec(sql);
 }
 
 static void teardown(void)
@@ -38,12 +81,19 @@ static void teardown(void)
     rmdir(dir);
 }
 
-static tk_store *open_store(void)
+/* The test's store, with claims that last `lease` seconds. */
+static tk_store *open_leased(double lease)
 {
     tk_store *s = NULL;
     tk_error err;
-    ck_assert_msg(tk_store_open(path, &s, &err) == TK_OK, "%s", err.message);
+    ck_assert_msg(tk_store_open(where, lease, &s, &err) == TK_OK, "%s", err.message);
+    ck_assert(tk_store_shared(s) == shared);
     return s;
+}
+
+static tk_store *open_store(void)
+{
+    return open_leased(30.0);
 }
 
 static const char input[] = "VECT\n1 3 0\n-3\n0\n0 0 0\n1 0 0\n0 1 0\n";
@@ -81,7 +131,7 @@ static const char *state_of(tk_store *s, int64_t id)
 START_TEST(a_job_reads_back_after_reopening)
 {
     tk_store *s = open_store();
-    int64_t id = add_job(s, "trefoil");
+    int64_t id = add_job(s, "trefoil"), claimed = 0;
     json_t *doc = get(s, id);
     ck_assert_str_eq(json_string_value(json_object_get(doc, "name")), "trefoil");
     ck_assert_str_eq(json_string_value(json_object_get(doc, "state")), "queued");
@@ -91,23 +141,16 @@ START_TEST(a_job_reads_back_after_reopening)
     tk_error err;
     ck_assert_int_eq(tk_job_options_of(doc, &o, &err), TK_OK);
     ck_assert_int_eq(o.run.max_steps, 77);
+    /* only the holder writes: a job not claimed is not */
+    ck_assert_int_eq(tk_store_put(s, doc, NULL, NULL, 0, 0, &err), TK_ENOTFOUND);
+    ck_assert_int_eq(tk_store_claim(s, &claimed, &err), TK_OK);
+    ck_assert_int_eq(claimed, id);
     tk_job_set_figures(doc, &r, &o);
-    json_object_set_new(doc, "state", json_string("done"));
+    json_object_set_new(doc, "state", json_string("running"));
     const char *parts[TK_PARTS] = {NULL, "VECT curve", "{\"struts\":[]}", "[1,2]", "{}"};
     double xyz[2][6] = {{0.1, 1.0 / 3.0, -2.5, 4, 5, 6}, {1e-300, 2, 3, 4, 5, 6}};
     tk_frame frames[2] = {{10, xyz[0], 6, "[2]"}, {20, xyz[1], 6, NULL}};
     ck_assert_int_eq(tk_store_put(s, doc, parts, frames, 0, 2, &err), TK_OK);
-    tk_store_close(&s);
-
-    s = open_store();
-    json_t *back = get(s, id);
-    ck_assert_msg(json_equal(doc, back), "%s", json_dumps(back, 0));
-    for (int k = 0; k < TK_PARTS; k++) {
-        char *text = NULL;
-        ck_assert_int_eq(tk_store_part(s, id, (tk_part)k, &text, NULL, &err), TK_OK);
-        ck_assert_str_eq(text, k == TK_PART_INPUT ? input : parts[k]);
-        free(text);
-    }
     tk_frame *f = NULL;
     size_t n = 0;
     ck_assert_int_eq(tk_store_frames(s, id, 1, 10, &f, &n, &err), TK_OK);
@@ -117,17 +160,98 @@ START_TEST(a_job_reads_back_after_reopening)
     ck_assert(memcmp(f[0].xyz, xyz[1], sizeof xyz[1]) == 0);
     ck_assert_ptr_null(f[0].layout);
     tk_frames_free(f, n);
-    /* frames from a place on replace those after it */
+    /* frames from a place on replace those after it; a state other than
+     * running lets go of the job */
     frames[0].step = 15;
+    json_object_set_new(doc, "state", json_string("done"));
     ck_assert_int_eq(tk_store_put(s, doc, NULL, frames, 1, 1, &err), TK_OK);
+    ck_assert_int_eq(tk_store_put(s, doc, NULL, NULL, 0, 0, &err), TK_ENOTFOUND);
+    tk_store_close(&s);
+
+    s = open_store();
+    json_t *back = get(s, id);
+    ck_assert_msg(json_equal(doc, back), "%s", json_dumps(back, 0));
+    for (int k = 0; k < TK_PARTS; k++) {
+        char *text = NULL;
+        size_t len = 0;
+        ck_assert_int_eq(tk_store_part(s, id, (tk_part)k, &text, &len, &err), TK_OK);
+        ck_assert_str_eq(text, k == TK_PART_INPUT ? input : parts[k]);
+        ck_assert_uint_eq(len, strlen(text));
+        free(text);
+    }
     ck_assert_int_eq(tk_store_frames(s, id, 0, 10, &f, &n, &err), TK_OK);
     ck_assert_uint_eq(n, 2);
     ck_assert(f[0].step == 10 && f[1].step == 15 && !strcmp(f[1].layout, "[2]"));
+    ck_assert(memcmp(f[0].xyz, xyz[0], sizeof xyz[0]) == 0);
     ck_assert(memcmp(f[1].xyz, xyz[0], sizeof xyz[0]) == 0);
     tk_frames_free(f, n);
     json_decref(doc);
     json_decref(back);
     tk_store_close(&s);
+}
+END_TEST
+
+/* Two stores on one database (two daemons): the job one claims is written
+ * and renewed by it alone; a cancellation asked through the other reaches
+ * the holder at its renewal. */
+START_TEST(a_running_job_is_its_holders)
+{
+    tk_store *a = open_store(), *b = open_store();
+    ck_assert_str_ne(tk_store_holder(a), tk_store_holder(b));
+    int64_t id = add_job(b, "k"), claimed = 0;
+    tk_error err;
+    bool cancel = true;
+    ck_assert_int_eq(tk_store_claim(a, &claimed, &err), TK_OK);
+    ck_assert_int_eq(claimed, id);
+    json_t *doc = get(b, id);
+    ck_assert_str_eq(json_string_value(json_object_get(doc, "state")), "running");
+    ck_assert_int_eq(tk_store_put(b, doc, NULL, NULL, 0, 0, &err), TK_ENOTFOUND);
+    ck_assert_int_eq(tk_store_renew(b, id, &cancel, &err), TK_ENOTFOUND);
+    ck_assert_int_eq(tk_store_renew(a, id, &cancel, &err), TK_OK);
+    ck_assert(!cancel);
+    ck_assert_int_eq(tk_store_cancel(b, id, &err), TK_EINVAL); /* not queued */
+    ck_assert_int_eq(tk_store_stop(b, id, &err), TK_OK);
+    ck_assert_int_eq(tk_store_renew(a, id, &cancel, &err), TK_OK);
+    ck_assert(cancel);
+    ck_assert_int_eq(tk_store_put(a, doc, NULL, NULL, 0, 0, &err), TK_OK);
+    json_object_set_new(doc, "state", json_string("cancelled"));
+    ck_assert_int_eq(tk_store_put(a, doc, NULL, NULL, 0, 0, &err), TK_OK);
+    ck_assert_int_eq(tk_store_stop(b, id, &err), TK_EINVAL); /* ended */
+    ck_assert_int_eq(tk_store_renew(a, id, &cancel, &err), TK_ENOTFOUND);
+    ck_assert_str_eq(state_of(b, id), "cancelled");
+    json_decref(doc);
+    tk_store_close(&a);
+    tk_store_close(&b);
+}
+END_TEST
+
+/* PostgreSQL: a claim not renewed within its lease (its daemon died) goes
+ * to the next store that claims, and the first can no longer write it. */
+START_TEST(a_lapsed_claim_goes_to_another_store)
+{
+    tk_store *a = open_leased(0.5), *b = open_leased(0.5);
+    int64_t id = add_job(a, "k"), got = 0;
+    tk_error err;
+    bool cancel;
+    ck_assert_int_eq(tk_store_claim(a, &got, &err), TK_OK);
+    ck_assert_int_eq(tk_store_claim(b, &got, &err), TK_ENOTFOUND); /* held */
+    nanosleep(&(struct timespec){0, 300000000L}, NULL);
+    ck_assert_int_eq(tk_store_renew(a, id, &cancel, &err), TK_OK);
+    nanosleep(&(struct timespec){0, 300000000L}, NULL); /* 0.6 s after the claim, 0.3 s after the renewal: still held */
+    ck_assert_int_eq(tk_store_claim(b, &got, &err), TK_ENOTFOUND);
+    nanosleep(&(struct timespec){0, 400000000L}, NULL);
+    ck_assert_int_eq(tk_store_claim(b, &got, &err), TK_OK);
+    ck_assert_int_eq(got, id);
+    json_t *doc = get(a, id);
+    ck_assert_int_eq(tk_store_put(a, doc, NULL, NULL, 0, 0, &err), TK_ENOTFOUND);
+    ck_assert_int_eq(tk_store_renew(a, id, &cancel, &err), TK_ENOTFOUND);
+    ck_assert_int_eq(tk_store_put(b, doc, NULL, NULL, 0, 0, &err), TK_OK);
+    /* a daemon's start leaves running jobs to their leases */
+    ck_assert_int_eq(tk_store_requeue(a, &err), TK_OK);
+    ck_assert_str_eq(state_of(a, id), "running");
+    json_decref(doc);
+    tk_store_close(&a);
+    tk_store_close(&b);
 }
 END_TEST
 
@@ -220,16 +344,18 @@ START_TEST(claims_take_each_queued_job_once_oldest_first)
     for (int id = 1; id <= CLAIMED; id++)
         ck_assert_int_eq(seen[id], 1);
     ck_assert_str_eq(state_of(s, 7), "running");
-    /* a running job is neither cancelled nor deleted by the store; queued
-     * again (a restart) it is claimed again */
+    /* a running job is neither cancelled nor deleted by the store; SQLite:
+     * queued again (a restart) it is claimed again */
     tk_error err;
     int64_t id;
     ck_assert_int_eq(tk_store_claim(s, &id, &err), TK_ENOTFOUND);
     ck_assert_int_eq(tk_store_cancel(s, 7, &err), TK_EINVAL);
     ck_assert_int_eq(tk_store_delete(s, 7, &err), TK_EINVAL);
-    ck_assert_int_eq(tk_store_requeue(s, &err), TK_OK);
-    ck_assert_int_eq(tk_store_claim(s, &id, &err), TK_OK);
-    ck_assert_int_eq(id, 1);
+    if (!shared) {
+        ck_assert_int_eq(tk_store_requeue(s, &err), TK_OK);
+        ck_assert_int_eq(tk_store_claim(s, &id, &err), TK_OK);
+        ck_assert_int_eq(id, 1);
+    }
     tk_store_close(&s);
 }
 END_TEST
@@ -327,7 +453,7 @@ START_TEST(an_unwritable_path_is_an_error)
 {
     tk_store *s = NULL;
     tk_error err;
-    ck_assert_int_eq(tk_store_open("/nonexistent/dir/jobs.db", &s, &err), TK_EIO);
+    ck_assert_int_eq(tk_store_open("/nonexistent/dir/jobs.db", 30.0, &s, &err), TK_EIO);
     ck_assert_ptr_null(s);
     ck_assert(strstr(err.message, "/nonexistent/dir/jobs.db"));
 }
@@ -409,6 +535,7 @@ int main(void)
     TCase *tc = tcase_create("sqlite");
     tcase_add_checked_fixture(tc, setup, teardown);
     tcase_add_test(tc, a_job_reads_back_after_reopening);
+    tcase_add_test(tc, a_running_job_is_its_holders);
     tcase_add_test(tc, missing_jobs_are_not_found);
     tcase_add_test(tc, listing_is_newest_first_filtered_and_paged);
     tcase_add_test(tc, claims_take_each_queued_job_once_oldest_first);
@@ -418,5 +545,21 @@ int main(void)
     tcase_add_test(tc, an_unwritable_path_is_an_error);
     tcase_add_test(tc, a_first_version_store_becomes_documents);
     suite_add_tcase(s, tc);
+    /* the same on PostgreSQL, where the tests have a server */
+    if (getenv("TK_PG_URL") && *getenv("TK_PG_URL")) {
+        TCase *pg = tcase_create("postgresql");
+        tcase_add_checked_fixture(pg, pg_setup, pg_teardown);
+        tcase_add_test(pg, a_job_reads_back_after_reopening);
+        tcase_add_test(pg, a_running_job_is_its_holders);
+        tcase_add_test(pg, missing_jobs_are_not_found);
+        tcase_add_test(pg, listing_is_newest_first_filtered_and_paged);
+        tcase_add_test(pg, claims_take_each_queued_job_once_oldest_first);
+        tcase_add_test(pg, the_queue_limit_holds_and_ends_are_final);
+        tcase_add_test(pg, an_owner_limit_counts_its_queued_and_running_jobs);
+        tcase_add_test(pg, a_lapsed_claim_goes_to_another_store);
+        suite_add_tcase(s, pg);
+    } else {
+        printf("SKIP store: the PostgreSQL cases (TK_PG_URL is not set)\n");
+    }
     return tkt_run_suite(s);
 }

@@ -2,7 +2,7 @@
 # Installs the Debian packages tightknot needs, quietly when all are there.
 set -eu
 packages="build-essential pkg-config check clang libsuitesparse-dev liblapack-dev
-libblas-dev libjansson-dev libmicrohttpd-dev libsqlite3-dev libcurl4-openssl-dev libgnutls28-dev
+libblas-dev libjansson-dev libmicrohttpd-dev libsqlite3-dev libcurl4-openssl-dev libgnutls28-dev libpq-dev postgresql
 wrk sqlite3 curl openssl chromium firefox-esr xvfb"
 missing=""
 for p in $packages; do

@@ -47,7 +47,7 @@ static tk_store *the_store(void)
         char path[sizeof dir + 16];
         snprintf(path, sizeof path, "%s/jobs.db", dir);
         tk_error err;
-        CHECK(tk_store_open(path, &fuzz_store, &err) == TK_OK);
+        CHECK(tk_store_open(path, 30.0, &fuzz_store, &err) == TK_OK);
         atexit(remove_store);
     }
     return fuzz_store;

@@ -6,11 +6,15 @@
 //   TK_DAEMON     the daemon (default build/tightknotd)
 //   TK_CLI        the command-line program (default build/tightknot)
 //   TK_CATALOGUE  the catalogue directory (default ../shared/catalogue)
+//   TK_PG_URL     a PostgreSQL server of the tests' own (tests/pg.sh), for
+//                 the tests that need one
+//   TK_STORE      "postgresql": every fresh daemon's store is a database of
+//                 its own on that server (default: a SQLite file)
 // Relative paths in the environment are taken from the current directory,
 // the defaults from the repository root.
 
 import assert from 'node:assert/strict';
-import { spawn, execFile } from 'node:child_process';
+import { spawn, execFile, execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
@@ -31,6 +35,23 @@ export const CLI = fromEnv('TK_CLI', 'build/tightknot');
 export const CATALOGUE = fromEnv('TK_CATALOGUE', '../shared/catalogue');
 
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// ---------------------------------------------------------------- PostgreSQL
+
+export const PG_URL = process.env.TK_PG_URL ?? '';
+export const ON_PG = PG_URL !== '' && process.env.TK_STORE === 'postgresql';
+// the lease of a daemon on PostgreSQL in these tests: a killed daemon's
+// jobs are taken up this many seconds after its last renewal
+export const PG_LEASE = 3;
+
+// A new, empty database on the tests' server; its URI.
+let databases = 0;
+export function pgDatabase() {
+    assert.ok(PG_URL, 'TK_PG_URL is not set (tests/pg.sh starts a server)');
+    const name = `tk_${process.pid}_${++databases}`;
+    execFileSync('psql', [PG_URL, '-qc', `CREATE DATABASE ${name}`]);
+    return PG_URL.slice(0, PG_URL.lastIndexOf('/') + 1) + name;
+}
 
 // ---------------------------------------------------------------- temp dirs
 
@@ -185,8 +206,9 @@ process.on('exit', () => {
 // {base, port, db, dir, proc, output(), stop(), kill()}.
 export async function startDaemon(o = {}) {
     const dir = o.dir ?? tempDir('daemon');
-    const db = o.db ?? join(dir, 'jobs.db');
+    const db = o.db ?? (ON_PG ? pgDatabase() : join(dir, 'jobs.db'));
     const args = ['--port', '0', '--db', db, '--catalogue', CATALOGUE];
+    if (db.startsWith('postgresql://')) args.push('--lease', String(PG_LEASE));
     if (o.workers) args.push('--workers', String(o.workers));
     if (o.queueLimit) args.push('--queue-limit', String(o.queueLimit));
     if (o.maxBody) args.push('--max-body', String(o.maxBody));
