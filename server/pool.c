@@ -675,8 +675,10 @@ int tk_pool_submit(tk_pool *p, json_t *doc, const char *input, tk_error *err)
     bool stopping = p->stopping;
     pthread_mutex_unlock(&p->lock);
     int rc = stopping ? tk_error_set(err, TK_EBUSY, "the service is shutting down")
-                      : tk_store_add(p->store, doc, input, p->cfg.queue_limit,
-                                     p->cfg.per_owner, err);
+                      : tk_store_add(p->store, doc, input,
+                                     &(tk_store_limits){p->cfg.queue_limit, p->cfg.per_owner,
+                                                        p->cfg.owner_bytes},
+                                     err);
     pthread_mutex_lock(&p->lock);
     p->submitted++;
     pthread_cond_signal(&p->wake);

@@ -46,6 +46,7 @@ typedef struct tk_pool_config {
     tk_priority priority; /* idle: workers use only CPU nothing else wants */
     size_t queue_limit;   /* queued jobs beyond which submissions are refused */
     size_t per_owner;     /* queued and running jobs a token's name may have (0: any) */
+    size_t owner_bytes;   /* bytes a token's name may have stored to submit (0: any) */
     size_t max_vertices;  /* a run's vertex limit, after re-resolution */
     double flush_seconds; /* how often a running job is written */
     size_t history;       /* history entries kept per job (thinned beyond) */

@@ -61,10 +61,28 @@ static int written(tk_store *s, int rc, const tk_error *err)
     return rc;
 }
 
-int tk_store_add(tk_store *s, json_t *doc, const char *input, size_t limit, size_t per_owner,
+int tk_store_add(tk_store *s, json_t *doc, const char *input, const tk_store_limits *limits,
                  tk_error *err)
 {
-    return written(s, s->ops->add(s, doc, input, limit, per_owner, err), err);
+    int rc = s->ops->add(s, doc, input, limits, err);
+    if (rc != TK_EBUSY)
+        return written(s, rc, err);
+    /* which limit: the queue's, the owner's jobs, or the owner's bytes */
+    const char *owner = json_string_value(json_object_get(doc, "owner"));
+    size_t counts[TK_JOB_STATES], mine = 0, n = 0;
+    json_t *docs = NULL;
+    for (int state = TK_JOB_QUEUED; owner && state <= TK_JOB_RUNNING; state++, mine += n) {
+        tk_store_list(s, state, owner, 0, 0, &docs, &n, err);
+        json_decref(docs);
+    }
+    if (tk_store_counts(s, counts, err) == TK_OK && counts[TK_JOB_QUEUED] >= limits->queued)
+        return tk_error_set(err, TK_EBUSY, "the queue is full (%zu jobs waiting)", limits->queued);
+    if (owner && limits->per_owner && mine >= limits->per_owner)
+        return tk_error_set(err, TK_EBUSY, "'%.64s' has %zu jobs queued or running, as many as "
+                            "a name may (--jobs-per-name)", owner, limits->per_owner);
+    return tk_error_set(err, TK_EBUSY, "'%.64s' has stored %zu bytes or more, as many as a "
+                        "name may (--bytes-per-name): delete finished jobs to make room",
+                        owner ? owner : "", limits->bytes);
 }
 
 int tk_store_put(tk_store *s, const json_t *doc, const char *const *parts,

@@ -56,11 +56,18 @@ bool tk_store_shared(const tk_store *s);
 /* Who claims jobs through this store: "host:pid:random", unique. */
 const char *tk_store_holder(const tk_store *s);
 
-/* Stores a new queued job (doc gets its id) with its input, unless
- * `limit` jobs are queued already, or (per_owner > 0) its owner (the
- * document's "owner") has per_owner jobs queued or running (TK_EBUSY,
- * saying which). */
-int tk_store_add(tk_store *s, json_t *doc, const char *input, size_t limit, size_t per_owner,
+/* What submissions may not go beyond: checked with the insert, in one
+ * step across daemons, so two cannot both take the last place. */
+typedef struct tk_store_limits {
+    size_t queued;    /* jobs queued, of all owners */
+    size_t per_owner; /* jobs queued or running of the document's owner (0: any) */
+    size_t bytes;     /* bytes stored for the owner's jobs, frames included (0: any) */
+} tk_store_limits;
+
+/* Stores a new queued job (doc gets its id) with its input, unless a
+ * limit is reached (TK_EBUSY, saying which); the owner's limits hold for
+ * a document with an "owner". */
+int tk_store_add(tk_store *s, json_t *doc, const char *input, const tk_store_limits *limits,
                  tk_error *err);
 
 /* Writes a job this store holds: its document (and state from it; a state
@@ -121,11 +128,12 @@ void tk_store_damage(tk_store *s, const char *what);
 
 /* ---- for the backends ---- */
 
-/* A backend's operations, each as its tk_store_ function says; `room`
+/* A backend's operations, each as its tk_store_ function says, but `add`
+ * answers a limit with TK_EBUSY alone (tk_store_add says which); `room`
  * says why jobs cannot be stored where the backend can tell (a full or
  * read-only file system), else leaves reason empty. */
 typedef struct tk_store_ops {
-    int (*add)(tk_store *, json_t *, const char *, size_t, size_t, tk_error *);
+    int (*add)(tk_store *, json_t *, const char *, const tk_store_limits *, tk_error *);
     int (*put)(tk_store *, const json_t *, const char *const *, const tk_frame *, size_t, size_t,
                tk_error *);
     int (*get)(tk_store *, int64_t, json_t **, tk_error *);

@@ -197,14 +197,14 @@ static int64_t int_at(const PGresult *r, int row, int col)
     return strtoll(PQgetvalue(r, row, col), NULL, 10);
 }
 
-static int pg_add(tk_store *s, json_t *doc, const char *input, size_t limit, size_t per_owner,
+static int pg_add(tk_store *s, json_t *doc, const char *input, const tk_store_limits *limits,
                   tk_error *err)
 {
     PGconn *c = take(s, err);
     if (!c)
         return TK_EIO;
     char *text = tk_json_dump(doc, false);
-    const char *owner = per_owner ? json_string_value(json_object_get(doc, "owner")) : NULL;
+    const char *owner = json_string_value(json_object_get(doc, "owner"));
     /* Under one lock across daemons, the insert's counts see every
      * submission before it: two cannot both take the last place. */
     PGresult *r = NULL;
@@ -213,22 +213,23 @@ static int pg_add(tk_store *s, json_t *doc, const char *input, size_t limit, siz
               (r = run(c,
                        "INSERT INTO jobs (state, doc, input) SELECT 'queued', $1::json, $2::bytea"
                        " WHERE (SELECT count(*) FROM jobs WHERE state = 'queued') < $3::bigint"
-                       " AND ($4::text IS NULL OR (SELECT count(*) FROM jobs WHERE state IN"
-                       " ('queued', 'running') AND doc->>'owner' = $4::text) < $5::bigint)"
+                       " AND ($4::text IS NULL OR $5::bigint = 0 OR (SELECT count(*) FROM jobs"
+                       " WHERE state IN ('queued', 'running') AND doc->>'owner' = $4::text)"
+                       " < $5::bigint)"
+                       " AND ($4::text IS NULL OR $6::bigint = 0 OR (SELECT coalesce(sum("
+                       "octet_length(doc::text) + octet_length(input)"
+                       " + coalesce(octet_length(curve), 0) + coalesce(octet_length(contacts), 0)"
+                       " + coalesce(octet_length(history), 0) + coalesce(octet_length(resume), 0)"
+                       " + (SELECT coalesce(sum(octet_length(xyz)), 0) FROM frames WHERE job ="
+                       " jobs.id)), 0) FROM jobs WHERE doc->>'owner' = $4::text) < $6::bigint)"
                        " RETURNING id",
-                       false, "tbiti", text, input, strlen(input), (int64_t)limit, owner,
-                       (int64_t)per_owner)) != NULL;
-    int rc = ok ? TK_OK : failed(c, err, "adding a job");
-    if (ok && PQntuples(r) == 1) {
+                       false, "tbitii", text, input, strlen(input), (int64_t)limits->queued,
+                       owner, (int64_t)limits->per_owner, (int64_t)limits->bytes)) != NULL;
+    int rc = !ok              ? failed(c, err, "adding a job")
+             : PQntuples(r) == 1 ? TK_OK
+                                 : TK_EBUSY;
+    if (!rc)
         json_object_set_new(doc, "id", json_integer(int_at(r, 0, 0)));
-    } else if (ok) { /* which limit: the queue's, or the owner's */
-        PGresult *q = run(c, "SELECT count(*) FROM jobs WHERE state = 'queued'", false, "");
-        bool full = !owner || !q || int_at(q, 0, 0) >= (int64_t)limit;
-        PQclear(q);
-        rc = full ? tk_error_set(err, TK_EBUSY, "the queue is full (%zu jobs waiting)", limit)
-                  : tk_error_set(err, TK_EBUSY, "'%.64s' has %zu jobs queued or running, as many "
-                                 "as a name may (--jobs-per-name)", owner, per_owner);
-    }
     PQclear(r);
     if (ok && !exec(c, "COMMIT") && !rc)
         rc = failed(c, err, "adding a job");

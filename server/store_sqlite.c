@@ -190,33 +190,35 @@ static void sq_close(tk_store *base)
     free(s);
 }
 
-static int sq_add(tk_store *s, json_t *doc, const char *input, size_t limit, size_t per_owner,
+static int sq_add(tk_store *s, json_t *doc, const char *input, const tk_store_limits *limits,
                   tk_error *err)
 {
     sqlite3 *db = take(s, err);
     if (!db)
         return TK_EIO;
     char *text = tk_json_dump(doc, false);
-    const char *owner = per_owner ? json_string_value(json_object_get(doc, "owner")) : NULL;
+    const char *owner = json_string_value(json_object_get(doc, "owner"));
     /* the limits and the insert in one statement: two requests cannot both
      * take the last place */
+#define BYTES(c) "coalesce(length(CAST(" c " AS BLOB)), 0)"
     sqlite3_stmt *st = prepare(db,
                                "INSERT INTO jobs (state, doc, input) SELECT 'queued', ?1, ?2"
                                " WHERE (SELECT count(*) FROM jobs WHERE state = 'queued') < ?3"
-                               " AND (?4 IS NULL OR (SELECT count(*) FROM jobs WHERE state IN"
-                               " ('queued', 'running') AND json_extract(doc, '$.owner') = ?4) < ?5)",
-                               "ttiti", text, input, (int64_t)limit, owner, (int64_t)per_owner);
+                               " AND (?4 IS NULL OR ?5 = 0 OR (SELECT count(*) FROM jobs WHERE"
+                               " state IN ('queued', 'running') AND json_extract(doc, '$.owner')"
+                               " = ?4) < ?5)"
+                               " AND (?4 IS NULL OR ?6 = 0 OR (SELECT coalesce(sum(" BYTES("doc")
+                               " + " BYTES("input") " + " BYTES("curve") " + " BYTES("contacts")
+                               " + " BYTES("history") " + " BYTES("resume") " + (SELECT"
+                               " coalesce(sum(length(xyz)), 0) FROM frames WHERE job = jobs.id)),"
+                               " 0) FROM jobs WHERE json_extract(doc, '$.owner') = ?4) < ?6)",
+                               "ttitii", text, input, (int64_t)limits->queued, owner,
+                               (int64_t)limits->per_owner, (int64_t)limits->bytes);
+#undef BYTES
     int rc = text && done(st) ? TK_OK : failed(db, err, "adding a job");
     free(text);
-    if (!rc && sqlite3_changes(db) == 0) { /* which limit: the queue's, or the owner's */
-        sqlite3_stmt *q = owner ? prepare(db, "SELECT count(*) FROM jobs WHERE state = 'queued'",
-                                          "") : NULL;
-        bool full = !q || (sqlite3_step(q) == SQLITE_ROW && sqlite3_column_int64(q, 0) >= (int64_t)limit);
-        sqlite3_finalize(q);
-        rc = full ? tk_error_set(err, TK_EBUSY, "the queue is full (%zu jobs waiting)", limit)
-                  : tk_error_set(err, TK_EBUSY, "'%.64s' has %zu jobs queued or running, as many "
-                                 "as a name may (--jobs-per-name)", owner, per_owner);
-    }
+    if (!rc && sqlite3_changes(db) == 0)
+        rc = TK_EBUSY;
     if (!rc)
         json_object_set_new(doc, "id", json_integer(sqlite3_last_insert_rowid(db)));
     give(s, db);

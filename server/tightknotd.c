@@ -29,6 +29,9 @@ static const tk_field fields[] = {
     ROW(pool.per_owner, jobs_per_name, SIZE, 100, 0, 1e7,
         "with --tokens: queued and running jobs a name may have before its submissions get "
         "429 (0: any number)"),
+    ROW(pool.owner_bytes, bytes_per_name, SIZE, 1 << 30, 0, 0x1p50,
+        "with --tokens: bytes stored for a name's jobs (inputs, curves, histories, frames) "
+        "beyond which its submissions get 429 until it deletes finished jobs (0: any number)"),
     ROW(api.max_vertices, max_vertices, SIZE, 200000, 3, TK_RUN_MAX_VERTICES,
         "largest knot accepted, after re-resolution"),
     ROW(api.max_body, max_body, SIZE, 16 << 20, 64, 0x1p32, "largest request body in bytes"),
@@ -116,7 +119,7 @@ int main(int argc, char **argv)
                        "reaches it submit and cancel jobs: give --tokens FILE, or "
                        "--allow-anonymous\n", api.bind), 1;
     if (!tokens_file)
-        pool_cfg.per_owner = 0;
+        pool_cfg.per_owner = pool_cfg.owner_bytes = 0;
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     if (!pool_cfg.workers)
         pool_cfg.workers = cores > 0 ? (size_t)cores : 1;

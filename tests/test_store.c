@@ -105,7 +105,7 @@ static int64_t add_job(tk_store *s, const char *name)
     o.run.max_steps = 77;
     json_t *doc = tk_job_new(name, NULL, &o, 1, 3);
     tk_error err;
-    ck_assert_msg(tk_store_add(s, doc, input, 1000, 0, &err) == TK_OK, "%s", err.message);
+    ck_assert_msg(tk_store_add(s, doc, input, &(tk_store_limits){1000, 0, 0}, &err) == TK_OK, "%s", err.message);
     int64_t id = tk_job_id(doc);
     ck_assert_int_gt(id, 0);
     json_decref(doc);
@@ -371,7 +371,7 @@ START_TEST(an_owner_limit_counts_its_queued_and_running_jobs)
     const int expect[] = {TK_OK, TK_OK, TK_EBUSY, TK_OK, TK_OK};
     for (int i = 0; i < 5; i++) {
         json_t *doc = tk_job_new("k", owners[i], &o, 1, 3);
-        ck_assert_int_eq(tk_store_add(s, doc, input, 1000, 2, &err), expect[i]);
+        ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 2, 0}, &err), expect[i]);
         if (expect[i])
             ck_assert_msg(strstr(err.message, "'ann' has 2 jobs queued or running"), "%s",
                           err.message);
@@ -380,9 +380,9 @@ START_TEST(an_owner_limit_counts_its_queued_and_running_jobs)
     int64_t id = 0;
     ck_assert_int_eq(tk_store_claim(s, &id, &err), TK_OK); /* ann's first runs: still counts */
     json_t *doc = tk_job_new("k", "ann", &o, 1, 3);
-    ck_assert_int_eq(tk_store_add(s, doc, input, 1000, 2, &err), TK_EBUSY);
+    ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 2, 0}, &err), TK_EBUSY);
     ck_assert_int_eq(tk_store_cancel(s, 2, &err), TK_OK); /* her second ends: room */
-    ck_assert_int_eq(tk_store_add(s, doc, input, 1000, 2, &err), TK_OK);
+    ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 2, 0}, &err), TK_OK);
     json_decref(doc);
     json_t *docs = NULL;
     size_t total = 0;
@@ -397,6 +397,50 @@ START_TEST(an_owner_limit_counts_its_queued_and_running_jobs)
 }
 END_TEST
 
+/* Per owner, the bytes stored for its jobs (documents, parts, frames)
+ * bound its submissions, whatever their state; deleting makes room. */
+START_TEST(an_owner_limit_counts_its_stored_bytes)
+{
+    tk_store *s = open_store();
+    tk_job_options o = TK_JOB_OPTIONS_INIT;
+    tk_error err;
+    json_t *doc = tk_job_new("k", "ann", &o, 1, 3);
+    ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 0, 1}, &err), TK_OK);
+    int64_t first = tk_job_id(doc), claimed = 0;
+    /* one job stored: beyond a limit of 1 byte, not beyond its own size */
+    size_t own = strlen(input) + strlen(json_dumps(doc, JSON_COMPACT)) - 10; /* less its id */
+    ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 0, 1}, &err), TK_EBUSY);
+    ck_assert_msg(strstr(err.message, "'ann' has stored 1 bytes or more"), "%s", err.message);
+    ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 0, 4 * own}, &err),
+                     TK_OK);
+    json_t *bo = tk_job_new("k", "bo", &o, 1, 3);
+    ck_assert_int_eq(tk_store_add(s, bo, input, &(tk_store_limits){1000, 0, 1}, &err), TK_OK);
+    /* a frame of a megabyte counts */
+    ck_assert_int_eq(tk_store_claim(s, &claimed, &err), TK_OK);
+    ck_assert_int_eq(claimed, first);
+    json_t *running = get(s, first);
+    double *xyz = calloc(3 * 43691, sizeof *xyz);
+    tk_frame f = {0, xyz, 3 * 43691, NULL};
+    ck_assert_int_eq(tk_store_put(s, running, NULL, &f, 0, 1, &err), TK_OK);
+    ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 0, 1000000}, &err),
+                     TK_EBUSY);
+    ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 0, 1100000}, &err),
+                     TK_OK);
+    json_object_set_new(running, "state", json_string("done"));
+    ck_assert_int_eq(tk_store_put(s, running, NULL, NULL, 1, 0, &err), TK_OK); /* frame kept */
+    ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 0, 1000000}, &err),
+                     TK_EBUSY); /* ended, but still stored */
+    ck_assert_int_eq(tk_store_delete(s, first, &err), TK_OK);
+    ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 0, 1000000}, &err),
+                     TK_OK);
+    free(xyz);
+    json_decref(running);
+    json_decref(doc);
+    json_decref(bo);
+    tk_store_close(&s);
+}
+END_TEST
+
 START_TEST(the_queue_limit_holds_and_ends_are_final)
 {
     tk_store *s = open_store();
@@ -404,7 +448,7 @@ START_TEST(the_queue_limit_holds_and_ends_are_final)
     tk_error err;
     for (int i = 0; i < 4; i++) {
         json_t *doc = tk_job_new("k", NULL, &o, 1, 3);
-        ck_assert_int_eq(tk_store_add(s, doc, input, 3, 0, &err), i < 3 ? TK_OK : TK_EBUSY);
+        ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){3, 0, 0}, &err), i < 3 ? TK_OK : TK_EBUSY);
         json_decref(doc);
     }
     ck_assert(strstr(err.message, "queue is full"));
@@ -541,6 +585,7 @@ int main(void)
     tcase_add_test(tc, claims_take_each_queued_job_once_oldest_first);
     tcase_add_test(tc, the_queue_limit_holds_and_ends_are_final);
     tcase_add_test(tc, an_owner_limit_counts_its_queued_and_running_jobs);
+    tcase_add_test(tc, an_owner_limit_counts_its_stored_bytes);
     tcase_add_test(tc, readers_do_not_wait_for_a_writer);
     tcase_add_test(tc, an_unwritable_path_is_an_error);
     tcase_add_test(tc, a_first_version_store_becomes_documents);
@@ -556,6 +601,7 @@ int main(void)
         tcase_add_test(pg, claims_take_each_queued_job_once_oldest_first);
         tcase_add_test(pg, the_queue_limit_holds_and_ends_are_final);
         tcase_add_test(pg, an_owner_limit_counts_its_queued_and_running_jobs);
+        tcase_add_test(pg, an_owner_limit_counts_its_stored_bytes);
         tcase_add_test(pg, a_lapsed_claim_goes_to_another_store);
         suite_add_tcase(s, pg);
     } else {

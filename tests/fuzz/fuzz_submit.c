@@ -60,7 +60,7 @@ static void store_and_read_back(const tk_submission *sub, const tk_curve *curve)
     char *input = strndup(sub->vect, sub->len);
     CHECK(doc && input);
     tk_error err;
-    CHECK(tk_store_add(store, doc, input, 1000000, 0, &err) == TK_OK);
+    CHECK(tk_store_add(store, doc, input, &(tk_store_limits){1000000, 0, 0}, &err) == TK_OK);
     int64_t id = tk_job_id(doc);
     json_t *back = NULL;
     CHECK(tk_store_get(store, id, &back, &err) == TK_OK);

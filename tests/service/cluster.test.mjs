@@ -10,48 +10,11 @@ import { describe, test } from 'node:test';
 import { join } from 'node:path';
 
 import {
-    CATALOGUE, PG_LEASE, PG_URL, pgDatabase, sleep, startDaemon, stopAll, submit, tempDir,
-    tighten, waitFinal, waitJob,
+    CATALOGUE, PG_LEASE, PG_URL, jobLines, jobRuns, pgDatabase, sleep, startDaemon, stopAll,
+    submit, tempDir, tighten, waitFinal, waitJob,
 } from './lib.mjs';
 
 const skip = PG_URL ? false : 'TK_PG_URL is not set: no PostgreSQL server to share';
-
-// The daemon's job lines: [{ms, id, what}] ("running from step S", "done
-// at step S", "taken up elsewhere: let go at step S", ...).
-function jobLines(d) {
-    const out = [];
-    for (const line of d.output().split('\n')) {
-        const m = /^tightknotd: (\S+Z) job (\d+): (.*)$/.exec(line);
-        if (m) out.push({ ms: Date.parse(m[1]), id: Number(m[2]), what: m[3] });
-    }
-    return out;
-}
-
-// Each daemon's runs of each job: [{daemon, id, from, to, step}], `to` the
-// time of its end line, or `killedAt` for a run that was under way.
-function runs(daemons, killedAt) {
-    const all = [];
-    daemons.forEach((d, k) => {
-        const open = new Map();
-        for (const l of jobLines(d)) {
-            const m = /^running from step (\d+)$/.exec(l.what);
-            if (m) {
-                assert.ok(!open.has(l.id), `daemon ${k} took up job ${l.id} while running it`);
-                open.set(l.id, { daemon: k, id: l.id, from: l.ms, step: Number(m[1]) });
-            } else {
-                const r = open.get(l.id);
-                assert.ok(r, `daemon ${k} ended job ${l.id} it was not running: ${l.what}`);
-                all.push({ ...r, to: l.ms, end: l.what });
-                open.delete(l.id);
-            }
-        }
-        for (const r of open.values()) {
-            assert.ok(killedAt[k] !== undefined, `daemon ${k} left job ${r.id} running`);
-            all.push({ ...r, to: killedAt[k], end: 'killed' });
-        }
-    });
-    return all;
-}
 
 describe('three daemons on one PostgreSQL database', { skip }, () => {
     test('12 jobs spread over all three; kill -9 of one mid-run: every job done as the command line computes it, none run twice at once', async (t) => {
@@ -97,7 +60,7 @@ describe('three daemons on one PostgreSQL database', { skip }, () => {
         const done = [];
         for (const j of jobs) done.push(await waitFinal(reader, j.id, { timeout: 120000 }));
 
-        const all = runs(daemons, { 1: killedAt });
+        const all = jobRuns(daemons, { 1: killedAt });
         // none ran twice at once: a job's runs follow each other
         for (const j of jobs) {
             const rs = all.filter((r) => r.id === j.id).sort((a, b) => a.from - b.from);

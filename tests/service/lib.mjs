@@ -208,7 +208,8 @@ export async function startDaemon(o = {}) {
     const dir = o.dir ?? tempDir('daemon');
     const db = o.db ?? (ON_PG ? pgDatabase() : join(dir, 'jobs.db'));
     const args = ['--port', '0', '--db', db, '--catalogue', CATALOGUE];
-    if (db.startsWith('postgresql://')) args.push('--lease', String(PG_LEASE));
+    if (db.startsWith('postgresql://') && !(o.args ?? []).includes('--lease'))
+        args.push('--lease', String(PG_LEASE));
     if (o.workers) args.push('--workers', String(o.workers));
     if (o.queueLimit) args.push('--queue-limit', String(o.queueLimit));
     if (o.maxBody) args.push('--max-body', String(o.maxBody));
@@ -274,6 +275,43 @@ export async function startDaemon(o = {}) {
         },
     };
     return d;
+}
+
+// The daemon's job lines: [{ms, id, what}] ("running from step S", "done
+// at step S", "taken up elsewhere: let go at step S", ...).
+export function jobLines(d) {
+    const out = [];
+    for (const line of d.output().split('\n')) {
+        const m = /^tightknotd: (\S+Z) job (\d+): (.*)$/.exec(line);
+        if (m) out.push({ ms: Date.parse(m[1]), id: Number(m[2]), what: m[3] });
+    }
+    return out;
+}
+
+// Each daemon's runs of each job: [{daemon, id, from, to, step}], `to` the
+// time of its end line, or `killedAt` for a run that was under way.
+export function jobRuns(daemons, killedAt) {
+    const all = [];
+    daemons.forEach((d, k) => {
+        const open = new Map();
+        for (const l of jobLines(d)) {
+            const m = /^running from step (\d+)$/.exec(l.what);
+            if (m) {
+                assert.ok(!open.has(l.id), `daemon ${k} took up job ${l.id} while running it`);
+                open.set(l.id, { daemon: k, id: l.id, from: l.ms, step: Number(m[1]) });
+            } else {
+                const r = open.get(l.id);
+                assert.ok(r, `daemon ${k} ended job ${l.id} it was not running: ${l.what}`);
+                all.push({ ...r, to: l.ms, end: l.what });
+                open.delete(l.id);
+            }
+        }
+        for (const r of open.values()) {
+            assert.ok(killedAt[k] !== undefined, `daemon ${k} left job ${r.id} running`);
+            all.push({ ...r, to: killedAt[k], end: 'killed' });
+        }
+    });
+    return all;
 }
 
 // Stops every daemon given, ignoring those already gone (for after()).

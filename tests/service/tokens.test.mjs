@@ -2,7 +2,8 @@
 // and a preflight needs a token of the file (401 otherwise); a job records
 // the name that submitted it, a name lists, reads and cancels its own jobs
 // (others' are 404 to read and 403 to cancel), an admin name all; a name
-// has at most --jobs-per-name jobs queued or running (429).  The remote
+// has at most --jobs-per-name jobs queued or running, and stores at most
+// --bytes-per-name (429).  The remote
 // client sends --token or $TIGHTKNOT_TOKEN.  A daemon on an address other
 // than loopback refuses to start without tokens unless --allow-anonymous.
 
@@ -105,6 +106,26 @@ test('a name has at most --jobs-per-name jobs queued or running; others still su
         await finalAs('alice', id);
     }
     assert.equal((await post('alice', 'steps=3')).status, 202, 'room again once cancelled');
+});
+
+test('a name stores at most --bytes-per-name: 429 until it deletes finished jobs', async () => {
+    const small = await startDaemon({ workers: 1, args: ['--tokens', join(dir, 'tokens'), '--bytes-per-name', '1'] });
+    try {
+        const as2 = (name) => ({ type: 'text/plain', ...as(name) });
+        const first = await small.post('/v1/jobs?steps=3', SQUARE, as2('alice'));
+        assert.equal(first.status, 202, first.text);
+        const over = await small.post('/v1/jobs?steps=3', SQUARE, as2('alice'));
+        assert.equal(over.status, 429, over.text);
+        assert.match(over.json.detail, /^'alice' has stored 1 bytes or more.*delete finished jobs/);
+        assert.equal((await small.post('/v1/jobs?steps=3', SQUARE, as2('carol'))).status, 202);
+        for (const t0 = Date.now(); (await small.get(`/v1/jobs/${first.json.id}`, as('alice'))).json.state !== 'done'; await sleep(50))
+            assert.ok(Date.now() - t0 < 30000, 'the first job did not end');
+        assert.equal((await small.post('/v1/jobs?steps=3', SQUARE, as2('alice'))).status, 429, 'ended, still stored');
+        assert.equal((await small.del(`/v1/jobs/${first.json.id}`, as('alice'))).status, 204);
+        assert.equal((await small.post('/v1/jobs?steps=3', SQUARE, as2('alice'))).status, 202, 'room once deleted');
+    } finally {
+        await small.stop();
+    }
 });
 
 test('the remote client sends --token or $TIGHTKNOT_TOKEN', async () => {
