@@ -88,7 +88,7 @@ BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
 .SECONDARY:
 
-.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-starts bench-service \
+.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-starts bench-service bench-cluster \
 	lint headers clean fuzz fuzz-bin
 
 WEB_OUT := $(BUILD)/web
@@ -196,7 +196,7 @@ run: deps all
 	@echo "tightknot: starting the service on http://127.0.0.1:$(PORT)/ (Ctrl-C stops it)"
 	$(Q)exec $(DAEMON) $(RUN_ARGS)
 
-bench: bench-struts bench-tighten bench-steps bench-starts bench-service
+bench: bench-struts bench-tighten bench-steps bench-starts bench-service bench-cluster
 
 bench-struts: deps all $(BENCH_BIN)
 	$(Q)$(BUILD)/bench/struts $(CATALOGUE)
@@ -212,6 +212,9 @@ bench-starts: deps all $(BENCH_BIN)
 
 bench-service: deps all
 	$(Q)./bench/service.sh $(BUILD) $(CATALOGUE)
+
+bench-cluster: deps all
+	$(Q)node bench/cluster.mjs $(BUILD) $(CATALOGUE)
 
 # Banned unsafe calls (curl's list).
 lint:
