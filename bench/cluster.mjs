@@ -18,10 +18,11 @@
 //   (environment: JOBS=30, LEASE=10 seconds, WINDOW=10 seconds of wrk,
 //   CONNECTIONS=200)
 
-import { execFileSync, spawnSync } from 'node:child_process';
+import { execFile, spawnSync } from 'node:child_process';
 import { chmodSync, mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
+import { promisify } from 'node:util';
 
 const build = resolve(process.argv[2] ?? 'build');
 process.env.TK_DAEMON = join(build, 'tightknotd');
@@ -120,7 +121,9 @@ const args = ['--lease', String(LEASE), '--max-per-address', '1000'];
             if (paced) wrk.push('-s', 'bench/paced.lua');
             wrk.push(`${d.base}v1/jobs/${ids[0]}`);
             if (paced) wrk.push('--', '100');
-            const out = execFileSync('wrk', wrk, { encoding: 'utf8' });
+            // not execFileSync: a blocked event loop would miss the daemon
+            // closing the client's idle connections meanwhile
+            const { stdout: out } = await promisify(execFile)('wrk', wrk, { encoding: 'utf8' });
             const field = (re) => (re.exec(out) ?? [])[1] ?? '?';
             const label = `${name}${paced ? ', every 100 ms' : ', flat out'}`;
             console.log(`  ${label.padEnd(40)} ${field(/Requests\/sec:\s+(\S+)/).padStart(11)} ` +
