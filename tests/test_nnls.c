@@ -1146,6 +1146,54 @@ START_TEST(proximal_problems)
 }
 END_TEST
 
+/* The flow's rounds (tk/nnls.h): the proximal weight shrinks tenfold a
+ * round from 1e-2 to 1e-8, each round centred at the last answer, on wide
+ * flow problems whose passive sets hold more than half as many columns as
+ * there are coordinates (so the solver's coordinate form, m x m, serves
+ * them), with the fallback at the small weights: every answer meets its
+ * proximal problem's KKT conditions, and the residual never rises from
+ * one round to the next by more than rounding. */
+START_TEST(proximal_rounds_on_wide_problems)
+{
+    tk_nnls *s = new_solver();
+    cholmod_common *cc = tk_nnls_common(s);
+    tkt_rng r = {777};
+    int fallback = 0, wide = 0;
+    for (int trial = 0; trial < 6; trial++) {
+        size_t V = trial < 3 ? 100 : 250;
+        cholmod_sparse *A = flow_matrix(cc, &r, V, 6 * V);
+        size_t m = A->nrow, n = A->ncol;
+        double *b = random_vector(&r, m);
+        double *c = calloc(n, sizeof *c), *x = calloc(n, sizeof *x);
+        ck_assert(c && x);
+        tk_nnls_options o = tight;
+        o.warm_start = true;
+        double previous = INFINITY;
+        for (double mu = 1e-2; mu > 1e-8 * 0.99; mu *= 0.1) {
+            char what[80];
+            snprintf(what, sizeof what, "trial %d (%zu x %zu) mu %g", trial, m, n, mu);
+            memcpy(c, x, n * sizeof *c);
+            o.proximal = mu;
+            tk_nnls_report rep;
+            ck_assert_msg(solve(s, A, b, x, &o, &rep) == TK_OK, "%s: not converged", what);
+            assert_proximal_kkt(A, b, c, mu, x, 1e-9, what);
+            ck_assert_msg(rep.residual <= previous * (1.0 + 1e-9), "%s: residual rose from %.17g to %.17g",
+                          what, previous, rep.residual);
+            previous = rep.residual;
+            fallback += rep.used_fallback;
+            wide += 2 * rep.passive > m;
+        }
+        free(b);
+        free(c);
+        free(x);
+        cholmod_free_sparse(&A, cc);
+    }
+    ck_assert_int_gt(fallback, 0);
+    ck_assert_int_gt(wide, 0);
+    tk_nnls_free(&s);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("nnls");
@@ -1165,6 +1213,7 @@ int main(void)
     tcase_add_test(tc, damped_min_norm_steps);
     tcase_add_test(tc, two_threads_match_series);
     tcase_add_test(tc, proximal_problems);
+    tcase_add_test(tc, proximal_rounds_on_wide_problems);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);
 }

@@ -24,6 +24,13 @@
  * A tk_nnls owns its cholmod_common and workspace: one per thread.  It keeps
  * the symbolic analysis between calls and reuses it when the passive set's
  * pattern repeats.
+ *
+ * Where the passive columns are more than half as many as the rows (many
+ * contacts) and the problem is the proximal one below with mu >= 1e-8,
+ * the solver works with the m x m matrix A_F D^-2 A_F^T + mu I instead of
+ * the n_F x n_F normal matrix (the coordinate form: far sparser there),
+ * and Lawson and Hanson modify its factor with rank-one updates and
+ * downdates (CHOLMOD's cholmod_updown) as columns join and leave.
  */
 #ifndef TK_NNLS_H
 #define TK_NNLS_H
@@ -68,7 +75,8 @@ typedef struct tk_nnls_report {
                                pivot ratio of its Cholesky factor, as
                                cholmod_rcond; 0 for a singular one; 1 when
                                no column is passive; of A_F^T A_F + mu I for
-                               the proximal problem) */
+                               the proximal problem, or in the coordinate
+                               form of A_F A_F^T + mu I, scaled likewise) */
     double residual;        /* || A x - b || at the answer */
     double proximal_term;   /* mu sum_i s_i^2 x_i (x_i - c_i) = -(A x) . (A x - b)
                                at the proximal answer (0 at the plain one):
