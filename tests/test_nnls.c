@@ -1177,8 +1177,8 @@ START_TEST(proximal_rounds_on_wide_problems)
             tk_nnls_report rep;
             ck_assert_msg(solve(s, A, b, x, &o, &rep) == TK_OK, "%s: not converged", what);
             assert_proximal_kkt(A, b, c, mu, x, 1e-9, what);
-            ck_assert_msg(rep.residual <= previous * (1.0 + 1e-9), "%s: residual rose from %.17g to %.17g",
-                          what, previous, rep.residual);
+            ck_assert_msg(rep.residual <= previous * (1.0 + 1e-9),
+                          "%s: residual rose from %.17g to %.17g", what, previous, rep.residual);
             previous = rep.residual;
             fallback += rep.used_fallback;
             wide += 2 * rep.passive > m;
