@@ -27,7 +27,9 @@ static void usage(void)
             "then for each vertex count (default 600 1200 2400 4800): resamples it,\n"
             "settles it for N steps (--settle, default 40), scales it into contact and\n"
             "prints milliseconds per step over N steps (--steps, default 5, or as many\n"
-            "as --budget seconds allow, default 300) with where the time went.\n");
+            "as --budget seconds allow, default 300) with where the time went.\n"
+            "With --curve FILE: tightens FILE's curve again (no autoscale, no escapes)\n"
+            "and prints each of its first N steps (--steps), the first one cold.\n");
 }
 
 static tk_run *start(const tk_curve *c, const tk_options *o)
@@ -41,6 +43,71 @@ static tk_run *start(const tk_curve *c, const tk_options *o)
     return run;
 }
 
+static void row(const tk_run *run, const tk_run_timing *a, const tk_run_timing *b, double n)
+{
+    const tk_step_report *last = tk_run_latest(run);
+    double ms = 1e3 / n;
+    size_t ns = 0, forced = 0;
+    const tk_strut *struts = tk_run_struts(run, &ns);
+    for (size_t j = 0; j < ns; j++)
+        forced += struts[j].force > 0.0;
+    printf("%8zu %7zu %6zu %6zu %9.1f %10.6f | %8.1f %8.1f %8.1f %8.1f %8.1f %8.1f | %6.1f "
+           "%6.1f\n",
+           last->vertices, last->struts, forced, last->kinks, ms * (b->total - a->total),
+           last->ropelength, ms * (b->search - a->search), ms * (b->matrix - a->matrix),
+           ms * (b->nnls - a->nnls), ms * (b->checks - a->checks),
+           ms * (b->stepping - a->stepping), ms * (b->recovery - a->recovery),
+           (double)(b->nnls_iterations - a->nnls_iterations) / n,
+           (double)(b->factorisations - a->factorisations) / n);
+    fflush(stdout);
+}
+
+static void header(void)
+{
+    printf("\n%8s %7s %6s %6s %9s %10s | %8s %8s %8s %8s %8s %8s | %6s %6s\n", "vertices",
+           "struts", "forced", "kinks", "ms/step", "ropelength", "search", "matrix", "nnls",
+           "checks", "stepping", "recovery", "iter", "facts");
+}
+
+static void footer(void)
+{
+    printf("(forced: struts with a positive force at the last step; the columns after\n"
+           " ropelength are milliseconds per step, stepping including the motion's matrix\n"
+           " and NNLS solves and its searches and checks; iter and facts: NNLS pivoting\n"
+           " iterations and Cholesky factorisations per step)\n");
+}
+
+/* --curve: FILE's curve tightened again, a row per step. */
+static int again(const char *path, long steps)
+{
+    tk_curve *c = NULL;
+    tk_error err;
+    if (tk_vect_read_file(path, NULL, &c, &err) != TK_OK) {
+        fprintf(stderr, "bench/steps: %s\n", err.message);
+        return 1;
+    }
+    tk_options o = TK_OPTIONS_INIT;
+    o.escapes = 0;
+    tk_run *run = start(c, &o);
+    printf("%s tightened again: %zu vertices, ropelength %.7f; each step's row:\n", path,
+           c->nvert, tk_run_latest(run)->ropelength);
+    header();
+    for (long k = 0; k < steps; k++) {
+        tk_run_timing a, b;
+        tk_run_timing_get(run, &a);
+        if (tk_run_step(run, &err) != TK_OK) {
+            fprintf(stderr, "bench/steps: %s\n", err.message);
+            return 1;
+        }
+        tk_run_timing_get(run, &b);
+        row(run, &a, &b, 1.0);
+    }
+    footer();
+    tk_run_free(&run);
+    tk_curve_free(&c);
+    return 0;
+}
+
 static void run_to_stop(tk_run *run)
 {
     tk_error err;
@@ -52,7 +119,7 @@ static void run_to_stop(tk_run *run)
 
 int main(int argc, char **argv)
 {
-    const char *dir = "../shared/catalogue";
+    const char *dir = "../shared/catalogue", *curve = NULL;
     double warm = 60.0, budget = 300.0;
     long settle = 40, steps = 5;
     size_t counts[16], ncounts = 0;
@@ -62,6 +129,8 @@ int main(int argc, char **argv)
             return 0;
         } else if (strcmp(argv[i], "--warm") == 0 && i + 1 < argc) {
             warm = strtod(argv[++i], NULL);
+        } else if (strcmp(argv[i], "--curve") == 0 && i + 1 < argc) {
+            curve = argv[++i];
         } else if (strcmp(argv[i], "--settle") == 0 && i + 1 < argc) {
             settle = strtol(argv[++i], NULL, 10);
         } else if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
@@ -78,6 +147,8 @@ int main(int argc, char **argv)
             return 1;
         }
     }
+    if (curve)
+        return again(curve, steps);
     if (ncounts == 0) {
         size_t defaults[] = {600, 1200, 2400, 4800};
         memcpy(counts, defaults, sizeof defaults);
@@ -104,9 +175,7 @@ int main(int argc, char **argv)
            warm, tk_run_latest(run)->ropelength, tight->nvert);
     tk_run_free(&run);
 
-    printf("\n%8s %7s %6s %6s %9s %10s | %8s %8s %8s %8s %8s %8s | %6s %6s\n", "vertices",
-           "struts", "forced", "kinks", "ms/step", "ropelength", "search", "matrix", "nnls", "checks", "stepping",
-           "recovery", "iter", "facts");
+    header();
     for (size_t k = 0; k < ncounts; k++) {
         tk_curve *resampled = NULL, *settled = NULL;
         if (tk_curve_resample_total(tight, counts[k], &resampled, &err) != TK_OK) {
@@ -135,30 +204,12 @@ int main(int argc, char **argv)
         tk_run_timing t;
         tk_run_timing_get(run, &t);
         const tk_step_report *last = tk_run_latest(run);
-        double n = (double)(last->step > 0 ? last->step : 1);
-        double ms = 1e3 / n;
-        size_t ns = 0, forced = 0;
-        const tk_strut *struts = tk_run_struts(run, &ns);
-        for (size_t j = 0; j < ns; j++)
-            forced += struts[j].force > 0.0;
-        printf("%8zu %7zu %6zu %6zu %9.1f %10.6f | %8.1f %8.1f %8.1f %8.1f %8.1f %8.1f | %6.1f "
-               "%6.1f\n",
-               settled->nvert, last->struts, forced, last->kinks, ms * (t.total - before.total),
-               last->ropelength, ms * (t.search - before.search),
-               ms * (t.matrix - before.matrix), ms * (t.nnls - before.nnls),
-               ms * (t.checks - before.checks), ms * (t.stepping - before.stepping),
-               ms * (t.recovery - before.recovery),
-               (double)(t.nnls_iterations - before.nnls_iterations) / n,
-               (double)(t.factorisations - before.factorisations) / n);
-        fflush(stdout);
+        row(run, &before, &t, (double)(last->step > 0 ? last->step : 1));
         tk_run_free(&run);
         tk_curve_free(&resampled);
         tk_curve_free(&settled);
     }
-    printf("(forced: struts with a positive force at the last step; the columns after\n"
-           " ropelength are milliseconds per step, stepping including the motion's matrix\n"
-           " and NNLS solves and its searches and checks; iter and facts: NNLS pivoting\n"
-           " iterations and Cholesky factorisations per step)\n");
+    footer();
     tk_curve_free(&tight);
     tk_curve_free(&loose);
     return 0;
