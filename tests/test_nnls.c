@@ -1159,8 +1159,8 @@ START_TEST(proximal_rounds_on_wide_problems)
     cholmod_common *cc = tk_nnls_common(s);
     tkt_rng r = {777};
     int fallback = 0, wide = 0;
-    for (int trial = 0; trial < 6; trial++) {
-        size_t V = trial < 3 ? 100 : 250;
+    for (int trial = 0; trial < 5; trial++) {
+        size_t V = trial < 3 ? 100 : 160;
         cholmod_sparse *A = flow_matrix(cc, &r, V, 6 * V);
         size_t m = A->nrow, n = A->ncol;
         double *b = random_vector(&r, m);
