@@ -1,6 +1,7 @@
 #!/bin/sh
 # Runs every test and closes with one line: "tests: N passed, M failed,
 # K skipped" (suites that report skips say so; a skip is never a pass).
+# Each test program's or suite's line ends with its seconds.
 #   run-all.sh [--unit-only] BUILD_DIR SANITIZER_BUILD_DIR CATALOGUE_DIR
 # Unit tests (Check, one process per test) run from both build directories;
 # the command-line, service and page tests run against BUILD_DIR's programs.
@@ -46,7 +47,7 @@ count_check() {
     bad=$(echo "$line" | sed -E 's/.*Failures: ([0-9]+), Errors: ([0-9]+).*/\1 \2/' | awk '{print $1 + $2}')
     passed=$((passed + checks - bad))
     failed=$((failed + bad))
-    echo "$1: $line"
+    echo "$1: $line ($(($(date +%s) - t0)) s)"
     [ "$bad" -eq 0 ] || grep -E ':[EF]:' "$log"
 }
 
@@ -60,6 +61,7 @@ for dir in "$build" $asan; do
     for t in "$dir"/tests/test_*; do
         case "$t" in *.o|*.d) continue ;; esac
         [ -x "$t" ] || continue
+        t0=$(date +%s)
         TK_QUICK=$quick "$t" >"$log" 2>&1
         count_check "$t"
     done
@@ -102,6 +104,7 @@ if [ "$unit_only" -eq 0 ]; then
             ;;
         esac
         [ -f "$t" ] || continue
+        t0=$(date +%s)
         TK_BUILD=$dir TK_ASAN_BUILD=$asan TK_DAEMON=$dir/tightknotd TK_CLI=$dir/tightknot \
             TK_WEB=$dir/web TK_SERVICE_TESTS=$only TK_STORE=$store sh "$t" >"$log" 2>&1
         line=$(grep -E '^[a-z-]+: [0-9]+ passed, [0-9]+ failed' "$log" | tail -n 1)
@@ -112,7 +115,7 @@ if [ "$unit_only" -eq 0 ]; then
         f=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\2/')
         k=$(echo "$line" | sed -nE 's/.* ([0-9]+) skipped.*/\1/p')
         passed=$((passed + p)); failed=$((failed + f)); skipped=$((skipped + ${k:-0}))
-        echo "$t ($dir, $store): $line"
+        echo "$t ($dir, $store): $line ($(($(date +%s) - t0)) s)"
         grep -E '^SKIP ' "$log"
         [ "$f" -eq 0 ] || grep -E '^FAIL|^not ok|^# fail|Error' "$log" | head -n 40
         # a ThreadSanitizer report: where the two accesses were
