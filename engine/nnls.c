@@ -608,7 +608,6 @@ typedef struct nnls_work {
     double *ptb;          /* n: P' b */
     bool lh_primal;       /* Lawson and Hanson use pL, not lhL */
     cholmod_factor *pL;   /* Lawson and Hanson's factor of P_F P_F' + mu I */
-    cholmod_sparse *C;    /* m x k: the columns joining or leaving it */
 } nnls_work;
 
 static void work_free(nnls_work *w)
@@ -648,8 +647,6 @@ static void work_free(nnls_work *w)
         cholmod_free_sparse(&w->P, &w->s->cc);
     if (w->pL)
         cholmod_free_factor(&w->pL, &w->s->cc);
-    if (w->C)
-        cholmod_free_sparse(&w->C, &w->s->cc);
     free(w->ym);
     free(w->ry);
     free(w->ptb);
@@ -1071,12 +1068,13 @@ static int lh_primal_modify(nnls_work *w, bool update, tk_error *err)
             w->F[k++] = (int)i;
     if (k == 0)
         return TK_OK;
-    if (w->C)
-        cholmod_free_sparse(&w->C, &w->s->cc);
-    /* the factor is of the rows in its fill-reducing order */
-    w->C = cholmod_submatrix(w->P, w->pL->Perm, (long)w->m, w->F, k, 1, 1, &w->s->cc);
-    if (!w->C || !cholmod_updown(update, w->C, w->pL, &w->s->cc) ||
-        w->s->cc.status < CHOLMOD_OK)
+    /* the columns joining or leaving, in the rows' fill-reducing order,
+     * which is the factor's */
+    cholmod_sparse *C =
+        cholmod_submatrix(w->P, w->pL->Perm, (long)w->m, w->F, k, 1, 1, &w->s->cc);
+    bool ok = C && cholmod_updown(update, C, w->pL, &w->s->cc) && w->s->cc.status >= CHOLMOD_OK;
+    cholmod_free_sparse(&C, &w->s->cc);
+    if (!ok)
         return cholmod_failure(w->s, "updown", err);
     for (size_t q = 0; q < k; q++)
         w->in_factor[w->F[q]] = update;
