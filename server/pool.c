@@ -20,7 +20,6 @@
 
 typedef struct slot {
     tk_pool *pool;
-    pthread_t thread;
     int64_t id;   /* the job it runs; 0: none */
     bool cancel;  /* its client asked to cancel it */
     bool lost;    /* the store no longer has it held here (another daemon took it) */
@@ -44,6 +43,7 @@ struct tk_pool {
     bool stopping, joined;
     unsigned long submitted;
     slot *slots;
+    pthread_t *threads;   /* threads[i] runs slots[i]; only tk_pool_start writes them */
     size_t nslots, ready;
     atomic_ullong steps_total;
 };
@@ -443,7 +443,7 @@ static void run_job(slot *sl, int64_t id)
         return; /* unreadable: it stays as stored, and health says why */
     job_run jr = {.slot = sl, .pool = p, .frame_after = -1, .last_step = -1};
     pthread_mutex_lock(&p->lock);
-    *sl = (slot){.pool = p, .thread = sl->thread, .id = id, .doc = doc, .opts = &jr.opts};
+    *sl = (slot){.pool = p, .id = id, .doc = doc, .opts = &jr.opts};
     pthread_mutex_unlock(&p->lock);
     int rc = tk_job_options_of(doc, &jr.opts, &err);
     if (!rc)
@@ -599,7 +599,10 @@ int tk_pool_start(tk_store *store, const tk_pool_config *cfg, tk_pool **out, tk_
 {
     *out = NULL;
     tk_pool *p = calloc(1, sizeof *p);
-    if (!p || !(p->slots = calloc(cfg->workers, sizeof *p->slots))) {
+    if (!p || !(p->slots = calloc(cfg->workers, sizeof *p->slots))
+        || !(p->threads = calloc(cfg->workers, sizeof *p->threads))) {
+        if (p)
+            free(p->slots);
         free(p);
         return tk_error_set(err, TK_ENOMEM, "out of memory");
     }
@@ -612,7 +615,7 @@ int tk_pool_start(tk_store *store, const tk_pool_config *cfg, tk_pool **out, tk_
     int rc = tk_store_requeue(store, err);
     for (size_t i = 0; !rc && i < cfg->workers; i++) {
         p->slots[i].pool = p;
-        if (pthread_create(&p->slots[i].thread, NULL, worker, &p->slots[i]))
+        if (pthread_create(&p->threads[i], NULL, worker, &p->slots[i]))
             rc = tk_error_set(err, TK_ENOMEM, "cannot start worker thread %zu", i + 1);
         else
             p->nslots++;
@@ -651,7 +654,7 @@ void tk_pool_halt(tk_pool *p)
     pthread_cond_broadcast(&p->tick);
     pthread_mutex_unlock(&p->lock);
     for (size_t i = 0; !joined && i < p->nslots; i++)
-        pthread_join(p->slots[i].thread, NULL);
+        pthread_join(p->threads[i], NULL);
     if (!joined && p->keeping)
         pthread_join(p->keeper, NULL);
 }
@@ -665,6 +668,7 @@ void tk_pool_free(tk_pool **pp)
     pthread_cond_destroy(&(*pp)->tick);
     pthread_mutex_destroy(&(*pp)->lock);
     free((*pp)->slots);
+    free((*pp)->threads);
     free(*pp);
     *pp = NULL;
 }
