@@ -165,11 +165,13 @@ $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIB)
 	$(Q)$(CC) $(LDFLAGS) -o $@ $< $(LIB) $(LDLIBS)
 
 # Every test: unit tests in the normal and sanitizer builds, then the
-# command-line tests; one closing line with the totals.
+# command-line tests; one closing line with the totals.  The builds use
+# every core unless make was given -j.
+TEST_JOBS := $(if $(filter -j%,$(MAKEFLAGS)),,-j$(shell nproc 2>/dev/null || echo 1))
 test: deps
-	$(Q)$(MAKE) --no-print-directory all tests-bin
-	$(Q)$(MAKE) --no-print-directory SANITIZE=1 all tests-bin
-	$(Q)$(MAKE) --no-print-directory SANITIZE=thread build/tsan/tightknotd build/tsan/tightknot
+	$(Q)$(MAKE) --no-print-directory $(TEST_JOBS) all tests-bin
+	$(Q)$(MAKE) --no-print-directory $(TEST_JOBS) SANITIZE=1 all tests-bin
+	$(Q)$(MAKE) --no-print-directory $(TEST_JOBS) SANITIZE=thread build/tsan/tightknotd build/tsan/tightknot
 	$(Q)./tests/run-all.sh $(BUILD) build/asan $(CATALOGUE)
 
 tests-bin: $(TEST_BIN) $(REPLAY_BIN)

@@ -20,12 +20,13 @@ passed=0
 failed=0
 skipped=0
 log=$(mktemp)
+lanes=$(mktemp -d)
 # A PostgreSQL server of the tests' own (tests/pg.sh, in a directory the
 # postgres user can reach): the store's tests on PostgreSQL, the service's
 # suite on it, and several daemons sharing one database.
 pgdir=$(mktemp -d /tmp/tk-pg-XXXXXX)
 chmod 755 "$pgdir"
-trap 'rm -f "$log"; ./tests/pg.sh stop "$pgdir/server" 2>/dev/null; rm -rf "$pgdir"' EXIT
+trap 'rm -rf "$log" "$lanes"; ./tests/pg.sh stop "$pgdir/server" 2>/dev/null; rm -rf "$pgdir"' EXIT
 TK_PG_URL=$(./tests/pg.sh start "$pgdir/server" 2>"$log")
 case $? in
 0) echo "postgresql: a server of the tests' own at $TK_PG_URL" ;;
@@ -53,11 +54,12 @@ count_check() {
 
 # The sanitizer build runs every test, but the long tightening runs in
 # their short form (TK_QUICK): they are the same code paths, ten times
-# slower under the sanitizers.
-for dir in "$build" $asan; do
-    [ -d "$dir/tests" ] || continue
-    quick=0
-    [ "$dir" = "$build" ] || quick=1
+# slower under the sanitizers.  One build directory's unit tests, one
+# program after another; closes with "counts: PASSED FAILED".
+unit_tests() {
+    dir=$1
+    quick=$2
+    log=$(mktemp)
     for t in "$dir"/tests/test_*; do
         case "$t" in *.o|*.d) continue ;; esac
         [ -x "$t" ] || continue
@@ -65,6 +67,33 @@ for dir in "$build" $asan; do
         TK_QUICK=$quick "$t" >"$log" 2>&1
         count_check "$t"
     done
+    rm -f "$log"
+    echo "counts: $passed $failed"
+}
+
+# The two build directories' unit tests side by side, one a core (none of
+# them times itself, and the PostgreSQL databases are named by process);
+# their lines printed in order once both are through.
+lane=0
+for dir in "$build" $asan; do
+    [ -d "$dir/tests" ] || continue
+    quick=0
+    [ "$dir" = "$build" ] || quick=1
+    lane=$((lane + 1))
+    # shellcheck disable=SC2030 # each lane counts its own
+    (passed=0; failed=0; unit_tests "$dir" "$quick") >"$lanes/$lane" 2>&1 &
+done
+wait
+# shellcheck disable=SC2031 # the totals here are this shell's own
+for out in "$lanes"/*; do
+    [ -f "$out" ] || continue
+    grep -v '^counts: ' "$out"
+    counts=$(grep '^counts: ' "$out" | tail -n 1)
+    if [ -z "$counts" ]; then
+        failed=$((failed + 1)); echo "FAIL the unit tests in $out: no totals"; continue
+    fi
+    passed=$((passed + $(echo "$counts" | cut -d ' ' -f 2)))
+    failed=$((failed + $(echo "$counts" | cut -d ' ' -f 3)))
 done
 
 # The command-line tests (tests/cli-*.sh) and the suites in directories
