@@ -77,21 +77,30 @@ static void footer(void)
            " iterations and Cholesky factorisations per step)\n");
 }
 
-/* --curve: FILE's curve tightened again, a row per step. */
-static int again(const char *path, long steps)
+/* The curve of the VECT file at path, or NULL (said on stderr, with
+ * `hint` after the reason). */
+static tk_curve *read_curve(const char *path, const char *hint)
 {
     tk_curve *c = NULL;
     tk_error err;
-    if (tk_vect_read_file(path, NULL, &c, &err) != TK_OK) {
-        fprintf(stderr, "bench/steps: %s\n", err.message);
+    if (tk_vect_read_file(path, NULL, &c, &err) != TK_OK)
+        fprintf(stderr, "bench/steps: %s%s\n", err.message, hint);
+    return c;
+}
+
+/* --curve: FILE's curve tightened again, a row per step. */
+static int again(const char *path, long steps)
+{
+    tk_curve *c = read_curve(path, "");
+    if (!c)
         return 1;
-    }
     tk_options o = TK_OPTIONS_INIT;
     o.escapes = 0;
     tk_run *run = start(c, &o);
     printf("%s tightened again: %zu vertices, ropelength %.7f; each step's row:\n", path,
            c->nvert, tk_run_latest(run)->ropelength);
     header();
+    tk_error err;
     for (long k = 0; k < steps; k++) {
         tk_run_timing a, b;
         tk_run_timing_get(run, &a);
@@ -156,12 +165,9 @@ int main(int argc, char **argv)
     }
     char path[4096];
     snprintf(path, sizeof path, "%s/3.1.vect", dir);
-    tk_curve *loose = NULL;
-    tk_error err;
-    if (tk_vect_read_file(path, NULL, &loose, &err) != TK_OK) {
-        fprintf(stderr, "bench/steps: %s (the catalogue is needed)\n", err.message);
+    tk_curve *loose = read_curve(path, " (the catalogue is needed)");
+    if (!loose)
         return 1;
-    }
     tk_options o = TK_OPTIONS_INIT;
     o.autoscale = true;
     o.resolution = 10;
@@ -169,6 +175,7 @@ int main(int argc, char **argv)
     tk_run *run = start(loose, &o);
     run_to_stop(run);
     tk_curve *tight = NULL;
+    tk_error err;
     if (tk_curve_copy(tk_run_curve(run), &tight, &err) != TK_OK)
         return 1;
     printf("trefoil 3.1 tightened for %.0f s at resolution 10: ropelength %.6f, %zu vertices\n",
