@@ -69,8 +69,10 @@ for dir in "$build" $asan; do
         [ -x "$t" ] && units="$units $t"
     done
 done
-units="$(for t in $units; do echo "$t"; done | grep -e tighten -e struts -e nnls -e history)
-$(for t in $units; do echo "$t"; done | grep -v -e tighten -e struts -e nnls -e history)"
+long='/test_(tighten|struts|nnls|history)$'
+units=$(printf '%s\n' $units)
+units="$(echo "$units" | grep -E "$long")
+$(echo "$units" | grep -vE "$long")"
 
 unit_lane() {
     i=0
