@@ -287,7 +287,8 @@ void tk_recovery_free(tk_run *r);
 /* ---- escape.c ---- */
 
 /* Whether the final polygon has converged: its ropelength fell by less
- * than a set fraction over a window of steps. */
+ * than a set fraction over a window of steps, or by less than a larger
+ * one for a set share of the budget (a crawl). */
 bool tk_escape_converged(const tk_run *r);
 /* Asks for an escape before the next step when tries and budget remain
  * (the attempt that converged is noted); false when none is left. */
@@ -326,6 +327,8 @@ int tk_schedule_fit(tk_run *r, tk_error *err);
 int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_error *err);
 /* The fraction of the step or time budget spent (0 without one). */
 double tk_schedule_spent(const tk_run *r);
+/* The same at the step of report s. */
+double tk_schedule_spent_at(const tk_run *r, const tk_step_report *s);
 /* Before a step: refines or re-resolves if due. */
 int tk_schedule_before_step(tk_run *r, tk_error *err);
 /* After a step's motion: polishing (or, on a coarse polygon, moving on). */

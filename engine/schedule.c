@@ -375,8 +375,12 @@ static int refine(tk_run *r, tk_error *err)
  * the polygon of its resolution. */
 double tk_schedule_spent(const tk_run *r)
 {
+    return tk_schedule_spent_at(r, &r->life.latest);
+}
+
+double tk_schedule_spent_at(const tk_run *r, const tk_step_report *s)
+{
     const tk_options *o = &r->opt;
-    const tk_step_report *s = &r->life.latest;
     double spent = 0.0;
     if (o->max_steps > 0)
         spent = fmax(spent, (double)s->step / (double)o->max_steps);
