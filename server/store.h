@@ -3,11 +3,10 @@
  * A job is a row of a few fixed columns: its id, its state (the queue is
  * the store: claiming takes the oldest queued job), its document
  * (job.h), its large parts, who holds it while it runs, and its frames in
- * a table of their own.  Two backends:
- * - SQLite (store_sqlite.c): one file in WAL mode for one daemon, each
- *   thread on a connection of its own, so a reader never waits for a
- *   writer;
- * - PostgreSQL (store_pg.c): one database shared by any number of daemons.
+ * a table of their own.  Two backends, one SQL (store.c):
+ * - SQLite: one file in WAL mode for one daemon, each thread on a
+ *   connection of its own, so a reader never waits for a writer;
+ * - PostgreSQL: one database shared by any number of daemons.
  *   A claim takes the oldest job that is queued or whose holder's lease
  *   ran out, in one statement (FOR UPDATE SKIP LOCKED), so no job runs
  *   twice at once; the holder renews the lease (tk_store_renew) and a
@@ -18,7 +17,6 @@
 #ifndef TK_SERVER_STORE_H
 #define TK_SERVER_STORE_H
 
-#include <pthread.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -125,47 +123,5 @@ bool tk_store_health(tk_store *s, char *reason, size_t size);
 /* A stored text did not read back as written (SQLite checks pages, not
  * the bytes in a row): health reports it until restart. */
 void tk_store_damage(tk_store *s, const char *what);
-
-/* ---- for the backends ---- */
-
-/* A backend's operations, each as its tk_store_ function says, but `add`
- * answers a limit with TK_EBUSY alone (tk_store_add says which); `room`
- * says why jobs cannot be stored where the backend can tell (a full or
- * read-only file system), else leaves reason empty. */
-typedef struct tk_store_ops {
-    int (*add)(tk_store *, json_t *, const char *, const tk_store_limits *, tk_error *);
-    int (*put)(tk_store *, const json_t *, const char *const *, const tk_frame *, size_t, size_t,
-               tk_error *);
-    int (*get)(tk_store *, int64_t, json_t **, tk_error *);
-    int (*part)(tk_store *, int64_t, tk_part, char **, size_t *, tk_error *);
-    int (*list)(tk_store *, int, const char *, size_t, size_t, json_t **, size_t *, tk_error *);
-    int (*claim)(tk_store *, int64_t *, tk_error *);
-    int (*renew)(tk_store *, int64_t, bool *, tk_error *);
-    int (*requeue)(tk_store *, tk_error *);
-    int (*cancel)(tk_store *, int64_t, tk_error *);
-    int (*stop)(tk_store *, int64_t, tk_error *);
-    int (*remove)(tk_store *, int64_t, tk_error *);
-    int (*frames)(tk_store *, int64_t, size_t, size_t, tk_frame **, size_t *, tk_error *);
-    int (*counts)(tk_store *, size_t[TK_JOB_STATES], tk_error *);
-    void (*room)(tk_store *, char *, size_t);
-    void (*close)(tk_store *);
-} tk_store_ops;
-
-/* What every backend's store begins with. */
-struct tk_store {
-    const tk_store_ops *ops;
-    bool shared;
-    double lease;
-    char holder[96];
-    pthread_mutex_t lock;                    /* guards the two texts that follow */
-    char write_error[TK_ERROR_MESSAGE_SIZE]; /* the last write's failure, "" once one succeeds */
-    char damage[TK_ERROR_MESSAGE_SIZE];      /* the first damage a reader found */
-};
-
-/* The backends' openers (tk_store_open chooses); tk_store_init sets up
- * the common part. */
-int tk_store_sqlite_open(const char *path, tk_store **out, tk_error *err);
-int tk_store_pg_open(const char *uri, double lease, tk_store **out, tk_error *err);
-void tk_store_init(tk_store *s, const tk_store_ops *ops);
 
 #endif
