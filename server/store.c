@@ -552,7 +552,7 @@ int tk_store_add(tk_store *s, json_t *doc, const char *input, const tk_store_lim
     const char *owner = json_string_value(json_object_get(doc, "owner"));
     /* under one lock across daemons, the insert's counts see every
      * submission before it */
-    rows r;
+    rows r = {0};
     bool ok = text && script(s, c, begin_sql[s->pg]) && script(s, c, lock_sql[s->pg]) &&
               query(s, c, &r, add_sql[s->pg], "jxitii", text, input, (int64_t)limits->queued,
                     owner, (int64_t)limits->per_owner, (int64_t)limits->bytes);
@@ -560,8 +560,7 @@ int tk_store_add(tk_store *s, json_t *doc, const char *input, const tk_store_lim
     int rc = !ok ? failed(s, c, err, "adding a job") : r.n == 1 ? TK_OK : TK_EBUSY;
     if (!rc)
         json_object_set_new(doc, "id", json_integer(int_at(&r, 0, 0)));
-    if (ok)
-        rows_free(&r);
+    rows_free(&r);
     free(text);
     give(s, c);
     return rc == TK_EBUSY ? which_limit(s, owner, limits, err) : written(s, rc, err);
