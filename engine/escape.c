@@ -17,16 +17,13 @@
  * 90% of the thickness and no coarse restart both ended back in the same
  * configuration (48.208, 55.13).  The deformation's size is the largest
  * (from one diameter down by 0.7 each time) that keeps the knot type and
- * a twentieth of the thickness (a far escape: the first try and every
- * second one after it) or three quarters of it (a near one: the others).
- * A far escape loosens the knot many times over, and its tightening from
- * there can find another basin: catalogue 6.1 at 186 vertices settles at
- * 57.733 (+1.8% over the atlas's 6_1), as does a copy of it doubled in
- * size and deformed down to 40% of its thickness, while one deformed down
- * to 7% reached 56.817 in 150 s; near escapes gained 0.01 each.  The far
- * one comes first because the first try may be the only one a budget
- * allows: catalogue 6.1 at resolution 5 for 120 s made two tries and
- * ended at 57.301 with a near one first, at 56.733 with a far one. */
+ * three quarters of the thickness (a near escape: every even try) or a
+ * twentieth of it (a far one: every odd try).  A far escape loosens the
+ * knot many times over, and its tightening from there can find another
+ * basin: catalogue 6.1 at 186 vertices settles at 57.733 (+1.8% over the
+ * atlas's 6_1), as does a copy of it doubled in size and deformed down
+ * to 40% of its thickness, while one deformed down to 7% reached 56.817
+ * in 150 s; near escapes gained 0.01 each. */
 #include <assert.h>
 #include <math.h>
 #include <stdlib.h>
@@ -159,7 +156,7 @@ static void deform(tk_curve *c, const tk_curve *from, const double *coef, double
 }
 
 /* The largest deformation of the best curve that keeps its type and
- * ESCAPE_FAR_THICKNESS of its thickness (ESCAPE_THICKNESS at odd tries),
+ * ESCAPE_THICKNESS of its thickness (ESCAPE_FAR_THICKNESS at odd tries),
  * into *out. */
 static int deformed_best(tk_run *r, tk_curve **out, double *amplitude, tk_error *err)
 {
@@ -172,7 +169,7 @@ static int deformed_best(tk_run *r, tk_curve **out, double *amplitude, tk_error 
     for (size_t i = 0; !rc && i < ncoef; i++)
         coef[i] = tk_rng_normal(&r->escape.rng);
     double a = ESCAPE_AMPLITUDE * r->tau;
-    double keep = tk_escape_tries(r) % 2 ? ESCAPE_THICKNESS : ESCAPE_FAR_THICKNESS;
+    double keep = tk_escape_tries(r) % 2 ? ESCAPE_FAR_THICKNESS : ESCAPE_THICKNESS;
     bool found = false;
     for (int size = 0; !rc && !found && size < ESCAPE_SIZES; size++, a *= ESCAPE_SHRINK) {
         deform(*out, best, coef, a);

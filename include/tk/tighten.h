@@ -111,9 +111,8 @@
     X(escapes, INT, 8, 0, 1000, "escapes",                                                   \
       "most escapes: each time the ropelength all but stops falling on the final polygon "   \
       "(or has crawled there for a fifth of the budget) while a tenth of the budget is "     \
-      "left, the best curve so far is deformed at random (the first time and every second " \
-      "one after it loosened many times over) and tightened again; the result is the best "  \
-      "curve found (0: none)")                                                              \
+      "left, the best curve so far is deformed at random (every second time loosened many "  \
+      "times over) and tightened again; the result is the best curve found (0: none)")      \
     X(seed, SEED, 1, 0, 9007199254740992.0, "seed",                                          \
       "of the escapes' random deformations: the same seed, the same run")
 
