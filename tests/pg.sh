@@ -25,6 +25,10 @@ case $cmd in
 start)
     mkdir -p "$dir"
     [ "$(id -u)" -ne 0 ] || chown postgres "$dir"
+    if ! as_owner test -w "$dir"; then
+        echo "pg.sh: the postgres user cannot reach $dir (its parents must be open to it: chmod 755)" >&2
+        exit 1
+    fi
     as_owner "$bin/initdb" -D "$dir/data" -A trust -U postgres -E UTF8 --locale=C.UTF-8 \
         >"$dir/initdb.log" 2>&1 || { cat "$dir/initdb.log" >&2; exit 1; }
     # fsync off: a test server that need not survive a power cut
