@@ -11,6 +11,7 @@
 #define _DEFAULT_SOURCE
 #include "store.h"
 
+#include <assert.h>
 #include <endian.h>
 #include <pthread.h>
 #include <stdarg.h>
@@ -296,6 +297,7 @@ static bool vquery(const tk_store *s, void *c, rows *out, const char *sql, const
 {
     rows mine = {0}, *r = out ? out : &mine;
     *r = (rows){0};
+    assert(strlen(types) <= MAX_PARAMS);
     if (!sql)
         return true;
     const char *values[MAX_PARAMS];
