@@ -624,9 +624,9 @@ static int ask(tk_store *s, rows *r, const char *what, tk_error *err, const char
                const char *types, ...)
 {
     *r = (rows){0};
-    void *c = take(s, err);
+    void *c = sql ? take(s, err) : NULL; /* no statement here: no connection either */
     if (!c)
-        return TK_EIO;
+        return sql ? TK_EIO : TK_OK;
     va_list ap;
     va_start(ap, types);
     bool ok = vquery(s, c, r, sql, types, ap);
@@ -806,12 +806,14 @@ void tk_store_damage(tk_store *s, const char *what)
  * keeps its own disks: a full one shows as a failed write). */
 static void room(const tk_store *s, char *reason, size_t size)
 {
+    if (s->pg)
+        return;
     char dir[4096];
     const char *slash = strrchr(s->where, '/');
     snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - s->where) + 1 : 1,
              slash ? s->where : ".");
     struct statvfs fs;
-    if (s->pg || statvfs(dir, &fs) != 0)
+    if (statvfs(dir, &fs) != 0)
         return;
     double free_bytes = (double)fs.f_bavail * (double)fs.f_frsize;
     if (fs.f_flag & ST_RDONLY)
