@@ -78,6 +78,8 @@
 #define NNLS_TIKHONOV_STEPS 3
 #define NNLS_DEFAULT_TOLERANCE 1e-10
 #define NNLS_DEFAULT_RCOND_FLOOR 1e-14
+/* modifications of a factor before it is built afresh (see lh_sync) */
+#define NNLS_LH_REFRESH 200
 
 /* A cached symbolic analysis (and the last numeric factor) for one
  * pattern of T. */
@@ -92,6 +94,7 @@ typedef struct nnls_slot {
 struct tk_nnls {
     cholmod_common cc;
     nnls_slot slot[NNLS_SLOTS];
+    nnls_slot primal;     /* the coordinate form's analysis (of all of P) */
     unsigned long clock;
     cholmod_dense *X, *Y, *E;  /* cholmod_solve2's result and workspace */
 };
@@ -296,29 +299,29 @@ static void slot_clear(tk_nnls *s, nnls_slot *slot)
     memset(slot, 0, sizeof *slot);
 }
 
-static nnls_slot *slot_find(tk_nnls *s, const cholmod_sparse *T, uint64_t h)
+/* Whether slot holds the analysis of T's pattern (hash h). */
+static bool slot_holds(const nnls_slot *slot, const cholmod_sparse *T, uint64_t h)
 {
     const int *Tp = T->p, *Ti = T->i;
     size_t nnz = (size_t)Tp[T->ncol];
-    for (int k = 0; k < NNLS_SLOTS; k++) {
-        nnls_slot *slot = &s->slot[k];
-        if (slot->L && slot->hash == h && slot->nrow == T->nrow && slot->ncol == T->ncol &&
-            slot->nnz == nnz && memcmp(slot->p, Tp, (T->ncol + 1) * sizeof *Tp) == 0 &&
-            memcmp(slot->i, Ti, nnz * sizeof *Ti) == 0)
-            return slot;
-    }
+    return slot->L && slot->hash == h && slot->nrow == T->nrow && slot->ncol == T->ncol &&
+           slot->nnz == nnz && memcmp(slot->p, Tp, (T->ncol + 1) * sizeof *Tp) == 0 &&
+           memcmp(slot->i, Ti, nnz * sizeof *Ti) == 0;
+}
+
+static nnls_slot *slot_find(tk_nnls *s, const cholmod_sparse *T, uint64_t h)
+{
+    for (int k = 0; k < NNLS_SLOTS; k++)
+        if (slot_holds(&s->slot[k], T, h))
+            return &s->slot[k];
     return NULL;
 }
 
-/* Analyses T into the least recently used slot, with the fill-reducing
- * ordering `order` of T's rows (NULL: AMD's own for this T). */
-static int slot_fill(tk_nnls *s, const cholmod_sparse *T, const int *order, uint64_t h,
-                     nnls_slot **out, tk_error *err)
+/* Analyses T into `slot`, with the fill-reducing ordering `order` of T's
+ * rows (NULL: AMD's own for this T). */
+static int slot_analyse(tk_nnls *s, nnls_slot *slot, const cholmod_sparse *T, const int *order,
+                        uint64_t h, tk_error *err)
 {
-    nnls_slot *slot = &s->slot[0];
-    for (int k = 1; k < NNLS_SLOTS && slot->L; k++)
-        if (!s->slot[k].L || s->slot[k].used < slot->used)
-            slot = &s->slot[k];
     slot_clear(s, slot);
     const int *Tp = T->p, *Ti = T->i;
     size_t nnz = (size_t)Tp[T->ncol];
@@ -347,8 +350,19 @@ static int slot_fill(tk_nnls *s, const cholmod_sparse *T, const int *order, uint
     slot->nrow = T->nrow;
     slot->ncol = T->ncol;
     slot->nnz = nnz;
-    *out = slot;
     return TK_OK;
+}
+
+/* slot_analyse into the least recently used of the slots. */
+static int slot_fill(tk_nnls *s, const cholmod_sparse *T, const int *order, uint64_t h,
+                     nnls_slot **out, tk_error *err)
+{
+    nnls_slot *slot = &s->slot[0];
+    for (int k = 1; k < NNLS_SLOTS && slot->L; k++)
+        if (!s->slot[k].L || s->slot[k].used < slot->used)
+            slot = &s->slot[k];
+    *out = slot;
+    return slot_analyse(s, slot, T, order, h, err);
 }
 
 /* The pivot-ratio estimate of rcond(M) described at the top; 0 when a
@@ -538,6 +552,7 @@ void tk_nnls_free(tk_nnls **p)
     tk_nnls *s = *p;
     for (int k = 0; k < NNLS_SLOTS; k++)
         slot_clear(s, &s->slot[k]);
+    slot_clear(s, &s->primal);
     cholmod_free_dense(&s->X, &s->cc);
     cholmod_free_dense(&s->Y, &s->cc);
     cholmod_free_dense(&s->E, &s->cc);
@@ -607,7 +622,7 @@ typedef struct nnls_work {
     double *ym, *ry;      /* m: y, and workspace */
     double *ptb;          /* n: P' b */
     bool lh_primal;       /* Lawson and Hanson use pL, not lhL */
-    cholmod_factor *pL;   /* Lawson and Hanson's factor of P_F P_F' + mu I */
+    cholmod_factor *pL;   /* the factor of P_F P_F' + mu I (s->primal's) */
 } nnls_work;
 
 static void work_free(nnls_work *w)
@@ -645,8 +660,6 @@ static void work_free(nnls_work *w)
     free(w->rhs);
     if (w->P)
         cholmod_free_sparse(&w->P, &w->s->cc);
-    if (w->pL)
-        cholmod_free_factor(&w->pL, &w->s->cc);
     free(w->ym);
     free(w->ry);
     free(w->ptb);
@@ -815,21 +828,98 @@ static int primal_answer(nnls_work *w, cholmod_factor *L, double *out, tk_error 
     return TK_OK;
 }
 
+/* The coordinate form keeps one factor of P_F P_F' + mu I through a solve,
+ * for block pivoting and Lawson and Hanson alike: a column joining the
+ * passive set is a rank-one update, one leaving a downdate
+ * (cholmod_updown, on a simplicial factor analysed for all the columns,
+ * so no change needs a new pattern), with the same refreshes as lh_sync.
+ * Between two passive sets of block pivoting on a flow step's warm start
+ * few columns change, and a factorisation of the whole (2,435 vertices,
+ * 11,722 struts: 386,058 entries in L) cost 20 ms.  The matrix is
+ * positive definite whatever F is (mu > 0), so a column never counts as
+ * dependent; a factor whose pivots say otherwise after modifications is
+ * built afresh. */
+static int primal_modify(nnls_work *w, bool update, tk_error *err)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < w->n; i++)
+        if (w->passive[i] != w->in_factor[i] && w->passive[i] == update)
+            w->F[k++] = (int)i;
+    if (k == 0)
+        return TK_OK;
+    /* the columns joining or leaving, in the rows' fill-reducing order,
+     * which is the factor's */
+    cholmod_sparse *C =
+        cholmod_submatrix(w->P, w->pL->Perm, (long)w->m, w->F, k, 1, 1, &w->s->cc);
+    bool ok = C && cholmod_updown(update, C, w->pL, &w->s->cc) && w->s->cc.status >= CHOLMOD_OK;
+    cholmod_free_sparse(&C, &w->s->cc);
+    if (!ok)
+        return cholmod_failure(w->s, "updown", err);
+    for (size_t q = 0; q < k; q++)
+        w->in_factor[w->F[q]] = update;
+    w->lh_updates += (int)k;
+    return TK_OK;
+}
+
+static int primal_sync(nnls_work *w, bool *singular, tk_error *err)
+{
+    size_t n = w->n, changes = 0, nf = 0;
+    for (size_t i = 0; i < n; i++) {
+        changes += w->in_factor[i] != w->passive[i];
+        nf += w->passive[i];
+    }
+    bool afresh =
+        !w->pL || w->lh_updates + (int)changes > NNLS_LH_REFRESH || changes > nf / 2 + 8;
+    double rcond = 0.0;
+    int rc;
+    if (!afresh) {
+        /* updates first: the matrix only grows until the downdates */
+        if ((rc = primal_modify(w, true, err)) != TK_OK ||
+            (rc = primal_modify(w, false, err)) != TK_OK)
+            return rc;
+        rcond = factor_rcond(w->pL);
+        afresh = rcond < w->rcond_floor;
+    }
+    if (afresh) {
+        if (!w->pL) {
+            /* the analysis of all of P holds every passive set's pattern,
+             * and P's pattern is often the last solve's */
+            uint64_t h = pattern_hash(w->P);
+            if (!slot_holds(&w->s->primal, w->P, h) &&
+                (rc = slot_analyse(w->s, &w->s->primal, w->P, NULL, h, err)) != TK_OK)
+                return rc;
+            w->pL = w->s->primal.L;
+        }
+        nf = 0;
+        for (size_t i = 0; i < n; i++)
+            if ((w->in_factor[i] = w->passive[i]))
+                w->F[nf++] = (int)i;
+        if ((rc = factor_once(w->s, w->P, w->F, nf, w->pL, w->mu, &rcond, err)) != TK_OK)
+            return rc;
+        w->rep.factorisations++;
+        w->lh_updates = 0;
+    }
+    w->rep.rcond = fmin(w->rep.rcond, rcond);
+    *singular = rcond < w->rcond_floor;
+    if (*singular)
+        w->lh_updates = NNLS_LH_REFRESH + 1;
+    return TK_OK;
+}
+
 /* passive_solve in the coordinate form; *done false when its factor was
  * too ill-conditioned (the other form then takes over). */
-static int primal_solve(nnls_work *w, size_t nf, double *out, bool *done, tk_error *err)
+static int primal_solve(nnls_work *w, double *out, bool *done, tk_error *err)
 {
     *done = false;
     int rc = primal_alloc(w, err);
     if (rc != TK_OK)
         return rc;
-    nnls_factor f = {NULL, 0.0, 1.0, 0, false};
-    rc = factor_normal(w->s, w->P, NULL, w->F, nf, w->mu, false, w->rcond_floor, &f, err);
-    w->rep.factorisations += f.factorisations;
-    if (rc != TK_OK || f.singular)
+    if (!w->in_factor && !(w->in_factor = calloc(w->n, sizeof *w->in_factor)))
+        return tk_error_set(err, TK_ENOMEM, "out of memory for nnls (%zu columns)", w->n);
+    bool singular;
+    if ((rc = primal_sync(w, &singular, err)) != TK_OK || singular)
         return rc;
-    w->rep.rcond = fmin(w->rep.rcond, f.rcond);
-    if ((rc = primal_answer(w, f.L, out, err)) != TK_OK)
+    if ((rc = primal_answer(w, w->pL, out, err)) != TK_OK)
         return rc;
     *done = true;
     return TK_OK;
@@ -853,9 +943,14 @@ static int passive_solve(nnls_work *w, bool may_regularise, bool *singular, doub
     }
     if (primal_pays(w, nf)) {
         bool done;
-        int rc = primal_solve(w, nf, out, &done, err);
+        int rc = primal_solve(w, out, &done, err);
         if (rc != TK_OK || done)
             return rc;
+        /* primal_sync used F for its lists */
+        nf = 0;
+        for (size_t i = 0; i < w->n; i++)
+            if (w->passive[i])
+                w->F[nf++] = (int)i;
     }
     int rc = order_columns(w, err);
     if (rc != TK_OK)
@@ -919,12 +1014,12 @@ static int passive_solve(nnls_work *w, bool may_regularise, bool *singular, doub
  * costs), every solve takes a step of refinement with M itself, and the
  * passive columns count as dependent when the pivots' ratio falls below
  * the floor, as for a factorisation. */
-#define NNLS_LH_REFRESH 200
 
 static int lh_alloc(nnls_work *w, tk_error *err)
 {
     size_t n = w->n;
-    w->in_factor = calloc(n, sizeof *w->in_factor);
+    if (!w->in_factor)
+        w->in_factor = calloc(n, sizeof *w->in_factor);
     if (!w->in_factor)
         return tk_error_set(err, TK_ENOMEM, "out of memory for nnls (%zu columns)", n);
     if (w->lh_primal)
@@ -1053,85 +1148,12 @@ static int lh_sync(nnls_work *w, bool *singular, tk_error *err)
     return TK_OK;
 }
 
-/* Lawson and Hanson in the coordinate form: a column joining the passive
- * set is a rank-one update of P_F P_F' + mu I, one leaving a downdate
- * (cholmod_updown, on a simplicial factor analysed for all the columns,
- * so no change needs a new pattern), with the same refreshes as lh_sync.
- * The matrix is positive definite whatever F is (mu > 0), so a column
- * never counts as dependent; a factor whose pivots say otherwise after
- * modifications is built afresh. */
-static int lh_primal_modify(nnls_work *w, bool update, tk_error *err)
-{
-    size_t k = 0;
-    for (size_t i = 0; i < w->n; i++)
-        if (w->passive[i] != w->in_factor[i] && w->passive[i] == update)
-            w->F[k++] = (int)i;
-    if (k == 0)
-        return TK_OK;
-    /* the columns joining or leaving, in the rows' fill-reducing order,
-     * which is the factor's */
-    cholmod_sparse *C =
-        cholmod_submatrix(w->P, w->pL->Perm, (long)w->m, w->F, k, 1, 1, &w->s->cc);
-    bool ok = C && cholmod_updown(update, C, w->pL, &w->s->cc) && w->s->cc.status >= CHOLMOD_OK;
-    cholmod_free_sparse(&C, &w->s->cc);
-    if (!ok)
-        return cholmod_failure(w->s, "updown", err);
-    for (size_t q = 0; q < k; q++)
-        w->in_factor[w->F[q]] = update;
-    w->lh_updates += (int)k;
-    return TK_OK;
-}
-
-static int lh_primal_sync(nnls_work *w, bool *singular, tk_error *err)
-{
-    size_t n = w->n, changes = 0, nf = 0;
-    for (size_t i = 0; i < n; i++) {
-        changes += w->in_factor[i] != w->passive[i];
-        nf += w->passive[i];
-    }
-    bool afresh =
-        !w->pL || w->lh_updates + (int)changes > NNLS_LH_REFRESH || changes > nf / 2 + 8;
-    double rcond = 0.0;
-    int rc;
-    if (!afresh) {
-        /* updates first: the matrix only grows until the downdates */
-        if ((rc = lh_primal_modify(w, true, err)) != TK_OK ||
-            (rc = lh_primal_modify(w, false, err)) != TK_OK)
-            return rc;
-        rcond = factor_rcond(w->pL);
-        afresh = rcond < w->rcond_floor;
-    }
-    if (afresh) {
-        if (!w->pL) {
-            int super = w->s->cc.supernodal;
-            w->s->cc.supernodal = CHOLMOD_SIMPLICIAL;
-            w->pL = cholmod_analyze(w->P, &w->s->cc);
-            w->s->cc.supernodal = super;
-            if (!w->pL || w->s->cc.status < CHOLMOD_OK)
-                return cholmod_failure(w->s, "analyze", err);
-        }
-        nf = 0;
-        for (size_t i = 0; i < n; i++)
-            if ((w->in_factor[i] = w->passive[i]))
-                w->F[nf++] = (int)i;
-        if ((rc = factor_once(w->s, w->P, w->F, nf, w->pL, w->mu, &rcond, err)) != TK_OK)
-            return rc;
-        w->rep.factorisations++;
-        w->lh_updates = 0;
-    }
-    w->rep.rcond = fmin(w->rep.rcond, rcond);
-    *singular = rcond < w->rcond_floor;
-    if (*singular)
-        w->lh_updates = NNLS_LH_REFRESH + 1;
-    return TK_OK;
-}
-
 /* passive_solve's answer (not regularised) from the modified factor. */
 static int lh_solve(nnls_work *w, bool *singular, double *out, tk_error *err)
 {
     size_t n = w->n;
     if (w->lh_primal) {
-        int rc = lh_primal_sync(w, singular, err);
+        int rc = primal_sync(w, singular, err);
         return rc != TK_OK || *singular ? rc : primal_answer(w, w->pL, out, err);
     }
     int rc = lh_sync(w, singular, err);
