@@ -1152,44 +1152,71 @@ END_TEST
  * there are coordinates (so the solver's coordinate form, m x m, serves
  * them), with the fallback at the small weights: every answer meets its
  * proximal problem's KKT conditions, and the residual never rises from
- * one round to the next by more than rounding. */
+ * one round to the next by more than rounding.  Each sequence runs twice,
+ * its fallback Lawson and Hanson's and then the interior point's: the
+ * proximal problem's answer is unique, so the two agree. */
+#define ROUNDS 7
+
 START_TEST(proximal_rounds_on_wide_problems)
 {
     tk_nnls *s = new_solver();
     cholmod_common *cc = tk_nnls_common(s);
     tkt_rng r = {777};
-    int fallback = 0, wide = 0;
+    int fallback = 0, wide = 0, interior = 0;
     for (int trial = 0; trial < 5; trial++) {
         size_t V = trial < 3 ? 100 : 160;
         cholmod_sparse *A = flow_matrix(cc, &r, V, 6 * V);
         size_t m = A->nrow, n = A->ncol;
         double *b = random_vector(&r, m);
         double *c = calloc(n, sizeof *c), *x = calloc(n, sizeof *x);
-        ck_assert(c && x);
-        tk_nnls_options o = tight;
-        o.warm_start = true;
-        double previous = INFINITY;
-        for (double mu = 1e-2; mu > 1e-8 * 0.99; mu *= 0.1) {
-            char what[80];
-            snprintf(what, sizeof what, "trial %d (%zu x %zu) mu %g", trial, m, n, mu);
-            memcpy(c, x, n * sizeof *c);
-            o.proximal = mu;
-            tk_nnls_report rep;
-            ck_assert_msg(solve(s, A, b, x, &o, &rep) == TK_OK, "%s: not converged", what);
-            assert_proximal_kkt(A, b, c, mu, x, 1e-9, what);
-            ck_assert_msg(rep.residual <= previous * (1.0 + 1e-9),
-                          "%s: residual rose from %.17g to %.17g", what, previous, rep.residual);
-            previous = rep.residual;
-            fallback += rep.used_fallback;
-            wide += 2 * rep.passive > m;
+        double *lh = calloc(ROUNDS * n, sizeof *lh);
+        ck_assert(c && x && lh);
+        for (int way = -1; way <= 1; way += 2) {
+            tk_nnls_options o = tight;
+            o.warm_start = true;
+            o.interior = way;
+            memset(x, 0, n * sizeof *x);
+            double previous = INFINITY, mu = 1e-2;
+            for (int round = 0; round < ROUNDS; round++, mu *= 0.1) {
+                char what[100];
+                snprintf(what, sizeof what, "trial %d (%zu x %zu) mu %g %s", trial, m, n, mu,
+                         way < 0 ? "Lawson-Hanson" : "interior point");
+                memcpy(c, x, n * sizeof *c);
+                o.proximal = mu;
+                tk_nnls_report rep;
+                ck_assert_msg(solve(s, A, b, x, &o, &rep) == TK_OK, "%s: not converged", what);
+                assert_proximal_kkt(A, b, c, mu, x, 1e-9, what);
+                ck_assert_msg(rep.residual <= previous * (1.0 + 1e-9),
+                              "%s: residual rose from %.17g to %.17g", what, previous,
+                              rep.residual);
+                previous = rep.residual;
+                fallback += rep.used_fallback;
+                wide += 2 * rep.passive > m;
+                if (way < 0) {
+                    ck_assert_int_eq(rep.interior_steps, 0);
+                    memcpy(lh + round * n, x, n * sizeof *x);
+                    continue;
+                }
+                interior += rep.interior_steps > 0;
+                double diff = 0.0, size = 0.0;
+                for (size_t j = 0; j < n; j++) {
+                    double sj = column_norm(A, j);
+                    diff = fmax(diff, sj * fabs(x[j] - lh[round * n + j]));
+                    size = fmax(size, sj * fabs(x[j]));
+                }
+                ck_assert_msg(diff <= 1e-9 * size, "%s: %g from Lawson and Hanson's (of %g)",
+                              what, diff, size);
+            }
         }
         free(b);
         free(c);
         free(x);
+        free(lh);
         cholmod_free_sparse(&A, cc);
     }
     ck_assert_int_gt(fallback, 0);
     ck_assert_int_gt(wide, 0);
+    ck_assert_int_gt(interior, 0);
     tk_nnls_free(&s);
 }
 END_TEST

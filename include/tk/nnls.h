@@ -29,8 +29,12 @@
  * contacts) and the problem is the proximal one below with mu >= 1e-8,
  * the solver works with the m x m matrix A_F D^-2 A_F^T + mu I instead of
  * the n_F x n_F normal matrix (the coordinate form: far sparser there),
- * and Lawson and Hanson modify its factor with rank-one updates and
- * downdates (CHOLMOD's cholmod_updown) as columns join and leave.
+ * and block pivoting and Lawson and Hanson modify its factor with rank-one
+ * updates and downdates (CHOLMOD's cholmod_updown) as columns join and
+ * leave.  In that form, when block pivoting gives up, a primal-dual
+ * interior point method finds the partition near the answer (a few dozen
+ * factorisations of one pattern) and block pivoting starts again from it;
+ * Lawson and Hanson come only after that.
  */
 #ifndef TK_NNLS_H
 #define TK_NNLS_H
@@ -58,12 +62,17 @@ typedef struct tk_nnls_options {
                                             + mu sum_i s_i^2 (x_i - c_i)^2,
                                s_i = ||a_i||, c = max(x, 0) on entry; 0: the
                                plain problem.  See below. */
+    int interior;           /* in the coordinate form, when block pivoting
+                               gives up: 0 the interior point where it is
+                               expected to cost less than Lawson and Hanson,
+                               1 always, -1 never */
 } tk_nnls_options;
 
-#define TK_NNLS_OPTIONS_INIT {0, 1e-10, 1e-14, false, 0.0}
+#define TK_NNLS_OPTIONS_INIT {0, 1e-10, 1e-14, false, 0.0, 0}
 
 typedef struct tk_nnls_report {
-    int iterations;         /* pivoting iterations */
+    int iterations;         /* pivoting iterations (and interior point
+                               steps) */
     int factorisations;     /* Cholesky factorisations done */
     bool used_fallback;     /* the single-variable exchange rule (or the
                                Lawson-Hanson fallback) was needed */
@@ -83,6 +92,8 @@ typedef struct tk_nnls_report {
                                how far it leaves the residual from orthogonal
                                to A x */
     size_t passive;         /* number of x_i > 0 */
+    int interior_steps;     /* of the interior point (coordinate form), 0
+                               when block pivoting needed none */
 } tk_nnls_report;
 
 /* A solver with its own CHOLMOD common.  Never prints. */
