@@ -1660,7 +1660,7 @@ static int interior_point(nnls_work *w, bool *guess, tk_error *err)
  * and block pivoting's new start.  So the choice goes by the violations
  * against the ratio of a factorisation's flops to the factor's entries:
  * on the tight 2,435-vertex trefoil (ratio 80) the two broke even between
- * 130 and 460 violations. */
+ * 135 and 460 violations. */
 #define NNLS_IPM_PAYS 3.0
 
 static int interior_pays(nnls_work *w, bool *pays, tk_error *err)
