@@ -611,7 +611,7 @@ typedef struct nnls_work {
     bool *blocked;        /* Lawson-Hanson: columns not to add again yet */
     cholmod_sparse *T;    /* A_F^T, scaled */
     double delta_mode;    /* regularisation every later solve gets */
-    size_t best_count;    /* block pivoting's best iterate's violations */
+    size_t best_count;    /* block pivoting's fewest violations (of best) */
     tk_nnls_report rep;
     /* Lawson and Hanson's factor (see lh_sync), once they take over */
     cholmod_factor *lhL;  /* n x n; position p is column order[p] */
@@ -883,15 +883,23 @@ static int primal_analysis(nnls_work *w, tk_error *err)
     return TK_OK;
 }
 
-static int primal_sync(nnls_work *w, bool *singular, tk_error *err)
+/* Whether factor L (NULL: none yet) is to be built afresh for the passive
+ * set rather than modified: after NNLS_LH_REFRESH modifications, or when
+ * more columns change than a rebuild costs. */
+static bool factor_stale(const nnls_work *w, const cholmod_factor *L)
 {
-    size_t n = w->n, changes = 0, nf = 0;
-    for (size_t i = 0; i < n; i++) {
+    size_t changes = 0, nf = 0;
+    for (size_t i = 0; i < w->n; i++) {
         changes += w->in_factor[i] != w->passive[i];
         nf += w->passive[i];
     }
-    bool afresh =
-        !w->pL || w->lh_updates + (int)changes > NNLS_LH_REFRESH || changes > nf / 2 + 8;
+    return !L || w->lh_updates + (int)changes > NNLS_LH_REFRESH || changes > nf / 2 + 8;
+}
+
+static int primal_sync(nnls_work *w, bool *singular, tk_error *err)
+{
+    size_t n = w->n;
+    bool afresh = factor_stale(w, w->pL);
     double rcond = 0.0;
     int rc;
     if (!afresh) {
@@ -905,7 +913,7 @@ static int primal_sync(nnls_work *w, bool *singular, tk_error *err)
     if (afresh) {
         if ((rc = primal_analysis(w, err)) != TK_OK)
             return rc;
-        nf = 0;
+        size_t nf = 0;
         for (size_t i = 0; i < n; i++)
             if ((w->in_factor[i] = w->passive[i]))
                 w->F[nf++] = (int)i;
@@ -1105,13 +1113,8 @@ static void lh_column(nnls_work *w, size_t i)
  * passive columns are dependent (see factor_rcond). */
 static int lh_sync(nnls_work *w, bool *singular, tk_error *err)
 {
-    size_t n = w->n, changes = 0, nf = 0;
-    for (size_t i = 0; i < n; i++) {
-        changes += w->in_factor[i] != w->passive[i];
-        nf += w->passive[i];
-    }
-    bool afresh =
-        !w->lhL || w->lh_updates + (int)changes > NNLS_LH_REFRESH || changes > nf / 2 + 8;
+    size_t n = w->n, nf = 0;
+    bool afresh = factor_stale(w, w->lhL);
     if (afresh) {
         /* afresh: from the identity, adding the rows in order costs one
          * factorisation (each row's trailing matrix is still the identity) */
@@ -1150,6 +1153,7 @@ static int lh_sync(nnls_work *w, bool *singular, tk_error *err)
     for (size_t p = 0; p < n; p++)
         if (w->passive[w->order[p]]) {
             double d = Lx[Lp[p]];
+            nf++;
             lo = isfinite(d) ? fmin(lo, d) : -INFINITY;
             hi = fmax(hi, d);
         }
@@ -1265,13 +1269,13 @@ static int block_pivoting(nnls_work *w, double *x, const bool *guess, bool *conv
                           tk_error *err)
 {
     size_t n = w->n;
-    size_t best_count = SIZE_MAX;   /* fewest infeasible seen */
     size_t bar = SIZE_MAX;          /* Kim and Park's beta */
     int budget = NNLS_FULL_EXCHANGE_BUDGET;
     int backup_steps = 0;
     bool singular;
     int rc;
     *converged = false;
+    w->best_count = SIZE_MAX;
     memset(x, 0, n * sizeof *x);
     memset(w->passive, 0, n * sizeof *w->passive);
     if (guess) {
@@ -1292,8 +1296,8 @@ static int block_pivoting(nnls_work *w, double *x, const bool *guess, bool *conv
                 ninf++;
                 last = i;
             }
-        if (ninf < best_count) {
-            best_count = w->best_count = ninf;
+        if (ninf < w->best_count) {
+            w->best_count = ninf;
             memcpy(w->best, x, n * sizeof *x);
         }
         if (ninf == 0) {
@@ -1477,48 +1481,50 @@ typedef struct nnls_ipm {
     double *vm, *rm;            /* m */
 } nnls_ipm;
 
-/* out = (P'P + Lambda)^-1 q by Woodbury, K factored in w->pL, with a step
- * of refinement whose residual comes from P. */
-static int ipm_solve(nnls_work *w, nnls_ipm *ip, const double *q, double *out, tk_error *err)
+/* out = (P'P + Lambda)^-1 q by Woodbury, K factored in w->pL:
+ * Lambda^-1 q - Lambda^-1 P' K^-1 P Lambda^-1 q. */
+static int ipm_apply(nnls_work *w, nnls_ipm *ip, const double *q, double *out, tk_error *err)
 {
-    size_t m = w->m, n = w->n;
     const int *Pi = w->P->i;
     const double *Px = w->P->x;
-    const double *rhs = q;
-    for (int pass = 0; pass < 2; pass++) {
-        double *d = pass ? ip->h : out;
-        memset(ip->vm, 0, m * sizeof *ip->vm);
-        for (size_t i = 0; i < n; i++) {
-            d[i] = rhs[i] / ip->lam[i];
-            size_t lo, hi;
-            col_span(w->P, i, &lo, &hi);
-            for (size_t e = lo; e < hi; e++)
-                ip->vm[Pi[e]] += Px[e] * d[i];
-        }
-        const double *sol;
-        int rc = factor_solve(w->s, w->pL, ip->vm, m, &sol, err);
-        if (rc != TK_OK)
-            return rc;
-        for (size_t i = 0; i < n; i++)
-            d[i] -= col_dot(w->P, i, sol) / ip->lam[i];
-        if (pass) {
-            for (size_t i = 0; i < n; i++)
-                out[i] += d[i];
-            break;
-        }
-        /* the residual q - (P'P + Lambda) out, into h, then its correction */
-        memset(ip->rm, 0, m * sizeof *ip->rm);
-        for (size_t i = 0; i < n; i++) {
-            size_t lo, hi;
-            col_span(w->P, i, &lo, &hi);
-            for (size_t e = lo; e < hi; e++)
-                ip->rm[Pi[e]] += Px[e] * out[i];
-        }
-        for (size_t i = 0; i < n; i++)
-            ip->h[i] = q[i] - col_dot(w->P, i, ip->rm) - ip->lam[i] * out[i];
-        memcpy(ip->q, ip->h, n * sizeof *ip->q);
-        rhs = ip->q;
+    memset(ip->vm, 0, w->m * sizeof *ip->vm);
+    for (size_t i = 0; i < w->n; i++) {
+        out[i] = q[i] / ip->lam[i];
+        size_t lo, hi;
+        col_span(w->P, i, &lo, &hi);
+        for (size_t e = lo; e < hi; e++)
+            ip->vm[Pi[e]] += Px[e] * out[i];
     }
+    const double *sol;
+    int rc = factor_solve(w->s, w->pL, ip->vm, w->m, &sol, err);
+    for (size_t i = 0; rc == TK_OK && i < w->n; i++)
+        out[i] -= col_dot(w->P, i, sol) / ip->lam[i];
+    return rc;
+}
+
+/* ipm_apply with a step of refinement whose residual q - (P'P + Lambda)
+ * out comes from P (into h). */
+static int ipm_solve(nnls_work *w, nnls_ipm *ip, const double *q, double *out, tk_error *err)
+{
+    const int *Pi = w->P->i;
+    const double *Px = w->P->x;
+    int rc = ipm_apply(w, ip, q, out, err);
+    if (rc != TK_OK)
+        return rc;
+    memset(ip->rm, 0, w->m * sizeof *ip->rm);
+    for (size_t i = 0; i < w->n; i++) {
+        size_t lo, hi;
+        col_span(w->P, i, &lo, &hi);
+        for (size_t e = lo; e < hi; e++)
+            ip->rm[Pi[e]] += Px[e] * out[i];
+    }
+    for (size_t i = 0; i < w->n; i++)
+        ip->h[i] = q[i] - col_dot(w->P, i, ip->rm) - ip->lam[i] * out[i];
+    /* q is spent (it may be ip->q itself): the correction goes there */
+    if ((rc = ipm_apply(w, ip, ip->h, ip->q, err)) != TK_OK)
+        return rc;
+    for (size_t i = 0; i < w->n; i++)
+        out[i] += ip->q[i];
     return TK_OK;
 }
 
@@ -1576,7 +1582,7 @@ static int interior_point(nnls_work *w, bool *guess, tk_error *err)
     double gap0 = 0.0;
     w->lh_updates = NNLS_LH_REFRESH + 1;
     for (int it = 0; it < NNLS_IPM_ITERATIONS; it++) {
-        /* g(z) and the mean complementarity */
+        /* g holds the dual residual g(z) - s; the mean complementarity */
         memcpy(ip.rm, w->b, m * sizeof *ip.rm);
         for (size_t i = 0; i < m; i++)
             ip.rm[i] = -ip.rm[i];
@@ -1632,10 +1638,9 @@ static int interior_point(nnls_work *w, bool *guess, tk_error *err)
          * order term; q = -g + Z^-1 r_c, r_c = sigma gap - z s - dz ds */
         for (size_t i = 0; i < n; i++) {
             double rcomp = sigma * gap - ip.z[i] * ip.s[i] - ip.dz[i] * ip.ds[i];
-            ip.h[i] = rcomp; /* kept for ds below */
+            ip.ds[i] = rcomp; /* ds below from it */
             ip.q[i] = -ip.g[i] + rcomp / ip.z[i];
         }
-        memcpy(ip.ds, ip.h, n * sizeof *ip.ds);
         if ((rc = ipm_solve(w, &ip, ip.q, ip.dz, err)) != TK_OK)
             break;
         for (size_t i = 0; i < n; i++)
