@@ -862,6 +862,13 @@ static int cmd_tighten(int argc, char **argv)
         printf("  type ");
         print_type(stdout, fin, tk_run_type_latest(run));
         putchar('\n');
+        tk_run_timing t;
+        tk_run_timing_get(run, &t);
+        printf("  recovery: %ld steps undone and taken shorter, %ld rescales after a step",
+               t.undone_steps, t.rescales);
+        if (t.rescales > 0)
+            printf(" (largest by a factor 1 + %.3g)", t.largest_rescale);
+        putchar('\n');
         size_t ne = 0;
         const tk_escape *e = tk_run_escapes(run, &ne);
         for (size_t k = 0; k < ne; k++)
