@@ -877,7 +877,7 @@ static tk_run *escaping_run(unsigned long long seed)
     o.autoscale = true;
     o.escapes = 2;
     o.seed = seed;
-    o.max_steps = 1500; /* the first escape starts after step 928 */
+    o.max_steps = 1500; /* the first escape starts after step 626 */
     tk_run *run = NULL;
     tk_error err;
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
@@ -1056,6 +1056,70 @@ START_TEST(a_resumed_run_keeps_its_escapes)
 }
 END_TEST
 
+/* The ropelength of each step, by step number (entry 0 the start's). */
+typedef struct ropelengths {
+    double at[4001];
+} ropelengths;
+
+static int keep_ropelength(const tk_step_report *s, void *user)
+{
+    ropelengths *h = user;
+    if (s->step >= 0 && s->step <= 4000)
+        h->at[s->step] = s->ropelength;
+    return 0;
+}
+
+static double lowest(const ropelengths *h, long from, long to)
+{
+    double low = INFINITY;
+    for (long k = from; k <= to; k++)
+        low = fmin(low, h->at[k]);
+    return low;
+}
+
+/* A final polygon whose ropelength still falls, by more than counts as
+ * converged (2e-5 over 300 steps) but by less than 2e-4, tries an escape
+ * once it has spent a fifth of the budget on that polygon (escape.c's
+ * crawl rule): T(2,5) from the round torus at 100 vertices (one polygon,
+ * made at the start) with 3,000 steps, at step 600.  The falls are
+ * reckoned here from the steps' own reports. */
+START_TEST(a_crawling_run_escapes_after_a_fifth_of_its_budget)
+{
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 5, 100, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.escapes = 1;
+    o.max_steps = 3000;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ropelengths *h = calloc(1, sizeof *h);
+    ck_assert_ptr_nonnull(h);
+    h->at[0] = tk_run_latest(run)->ropelength;
+    tk_run_set_progress(run, keep_ropelength, h);
+    while (tk_run_latest(run)->escapes == 0 && tk_run_latest(run)->step < o.max_steps)
+        ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
+    size_t ne = 0;
+    const tk_escape *e = tk_run_escapes(run, &ne);
+    ck_assert_uint_eq(ne, 1);
+    ck_assert_int_eq(e[0].step, o.max_steps / 5);
+    long at = e[0].step;
+    double fall = (lowest(h, at - 599, at - 300) - lowest(h, at - 299, at)) /
+                  lowest(h, at - 599, at - 300);
+    printf("crawl: escape after step %ld of %ld, the ropelength fell by %.3g over the "
+           "300 steps before\n",
+           at, o.max_steps, fall);
+    ck_assert(fall > 2e-5 && fall < 2e-4);
+    /* from where it stood: the first escape's best curve is the one that
+     * converged (or crawled) */
+    ck_assert(e[0].from == h->at[at]);
+    free(h);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("tighten");
@@ -1070,6 +1134,7 @@ int main(void)
     tcase_add_test(tc, escapes_keep_the_best_and_repeat);
     tcase_add_test(tc, a_resumed_run_goes_on_where_it_was);
     tcase_add_test(tc, a_resumed_run_keeps_its_escapes);
+    tcase_add_test(tc, a_crawling_run_escapes_after_a_fifth_of_its_budget);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
     tcase_add_test(tc, vertices_option_ends_at_exactly_that_count);
