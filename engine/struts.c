@@ -36,6 +36,13 @@
  * 16 reach 2.2 times the plain minimum. */
 #define SLOW_WIDENINGS 16
 
+/* An edge as the pair bound sees it (set by refit). */
+typedef struct edge_frame {
+    double mid[3];  /* midpoint */
+    double dir[3];  /* unit direction (0 for an edge of length 0) */
+    double half;    /* half its length */
+} edge_frame;
+
 typedef struct tree_node {
     double lo[3], hi[3];
     size_t first, end;  /* global edge range [first, end) */
@@ -57,6 +64,7 @@ struct tk_strut_finder {
     size_t *prefix_offset;    /* ncomp: start of each component's sums */
     tree_node *nodes;
     size_t nnodes;
+    edge_frame *frames;       /* per edge, of the curve last fitted */
 };
 
 /* The state of one query. */
@@ -114,6 +122,7 @@ void tk_strut_finder_free(tk_strut_finder **p)
     free(f->prefix);
     free(f->prefix_offset);
     free(f->nodes);
+    free(f->frames);
     free(f);
     *p = NULL;
 }
@@ -171,9 +180,10 @@ int tk_strut_finder_new(const tk_curve *c, tk_strut_finder **out, tk_error *err)
     f->prefix = malloc((c->nvert + c->ncomp) * sizeof(double));
     f->prefix_offset = malloc(c->ncomp * sizeof(size_t));
     f->nodes = malloc(2 * m * sizeof(tree_node));
+    f->frames = malloc(m * sizeof(edge_frame));
     if (!f->head || !f->tail || !f->comp || !f->local || !f->prev || !f->next ||
         !f->comp_first_edge || !f->comp_closed || !f->prefix || !f->prefix_offset ||
-        !f->nodes) {
+        !f->nodes || !f->frames) {
         tk_strut_finder_free(&f);
         return tk_error_set(err, TK_ENOMEM, "out of memory for the strut tree (%zu edges)", ne);
     }
@@ -225,10 +235,17 @@ void tk_strut_finder_refit(tk_strut_finder *f, const tk_curve *c)
         }
         for (size_t e = n->first; e < n->end; e++) {
             const double *a = c->xyz + 3 * f->head[e], *b = c->xyz + 3 * f->tail[e];
+            edge_frame *fr = &f->frames[e];
             for (int k = 0; k < 3; k++) {
                 n->lo[k] = fmin(n->lo[k], fmin(a[k], b[k]));
                 n->hi[k] = fmax(n->hi[k], fmax(a[k], b[k]));
+                fr->mid[k] = 0.5 * (a[k] + b[k]);
+                fr->dir[k] = b[k] - a[k];
             }
+            double len = sqrt(tk_dot3(fr->dir, fr->dir));
+            for (int k = 0; k < 3; k++)
+                fr->dir[k] = len > 0.0 ? fr->dir[k] / len : 0.0;
+            fr->half = 0.5 * len;
         }
     }
 }
@@ -414,6 +431,30 @@ static void strut_from(const tk_strut_finder *f, size_t i, size_t j,
     s->force = 0.0;
 }
 
+/* Whether edges i and j are farther apart than sqrt(b2), by a bound
+ * cheaper than their closest points.  With u the unit direction of i and
+ * w the offset of j's midpoint from i's, a point of j minus a point of i
+ * has a component along u of at least |w.u| - |i|/2 - |j.u|/2 and one
+ * across u of at least |P w| - |P j|/2 (P the projection across u).  Two
+ * strands side by side pair up, leaf by leaf, edges a few apart along
+ * them, farther than any bound near the diameter; their boxes cannot
+ * tell, the component along u can. */
+static bool pair_beyond(const tk_strut_finder *f, size_t i, size_t j, double b2)
+{
+    const edge_frame *a = &f->frames[i], *b = &f->frames[j];
+    double w[3];
+    for (int k = 0; k < 3; k++)
+        w[k] = b->mid[k] - a->mid[k];
+    double wu = tk_dot3(w, a->dir), cu = tk_dot3(b->dir, a->dir);
+    double along = fmax(fabs(wu) - a->half - b->half * fabs(cu), 0.0);
+    if (along * along > b2)
+        return true;
+    double across = sqrt(fmax(tk_dot3(w, w) - wu * wu, 0.0)) -
+                    b->half * sqrt(fmax(1.0 - cu * cu, 0.0));
+    across = fmax(across, 0.0);
+    return along * along + across * across > b2;
+}
+
 /* Tests global edges i < j. */
 static void test_pair(query *qy, size_t i, size_t j)
 {
@@ -471,9 +512,12 @@ static void visit(query *qy, size_t xi, size_t yi)
     if (node_pair_pruned(qy, x, y))
         return;
     if (!x->left && !y->left) {
+        /* (the margin is far above the rounding of the bound and of a
+         * distance; the frames are the fitted curve's, as the boxes) */
         for (size_t i = x->first; i < x->end; i++)
             for (size_t j = (xi == yi ? i + 1 : y->first); j < y->end; j++)
-                test_pair(qy, i < j ? i : j, i < j ? j : i);
+                if (!pair_beyond(qy->f, i, j, qy->bound * qy->bound * (1.0 + 1e-9)))
+                    test_pair(qy, i < j ? i : j, i < j ? j : i);
         return;
     }
     size_t pairs[3][2];

@@ -121,6 +121,70 @@ START_TEST(tree_matches_brute_force_on_generated)
 }
 END_TEST
 
+/* Two strands side by side, as in a tight knot: a stadium (straight sides
+ * 10 long at distance 1, caps of radius 1/2) of 2,000 vertices evenly
+ * spaced, moved by up to 1e-4 so that its contacts differ.  Most edge
+ * pairs the tree's leaves meet are a few edges apart along the sides and
+ * just farther than a bound near 1: the tree's cheap pair bound
+ * (struts.c, pair_beyond) must drop those and no other.  Struts and the
+ * closest pair against brute force at bounds 1e-6 to 1e-2 above the
+ * shortest. */
+START_TEST(tree_matches_brute_force_on_strands_side_by_side)
+{
+    size_t n = 2000, counts[1] = {n};
+    bool closed[1] = {true};
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_curve_new(&c, 1, counts, closed, NULL), TK_OK);
+    double side = 10.0, cap = M_PI * 0.5, total = 2.0 * (side + cap);
+    for (size_t k = 0; k < n; k++) {
+        double s = total * (double)k / (double)n, *p = c->xyz + 3 * k;
+        if (s < side) {
+            p[0] = s, p[1] = 0.0;
+        } else if (s < side + cap) {
+            double a = (s - side) / 0.5;
+            p[0] = side + 0.5 * sin(a), p[1] = 0.5 - 0.5 * cos(a);
+        } else if (s < 2.0 * side + cap) {
+            p[0] = side - (s - side - cap), p[1] = 1.0;
+        } else {
+            double a = (s - 2.0 * side - cap) / 0.5;
+            p[0] = -0.5 * sin(a), p[1] = 0.5 + 0.5 * cos(a);
+        }
+        p[1] += 5e-5 * cos(1.7 * (double)k);
+        p[2] = 1e-4 * sin(2.39996 * (double)k);
+    }
+    tk_strut_finder *f = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_strut_finder_new(c, &f, &err), TK_OK);
+    double shortest = tk_struts_shortest_brute(c, NULL);
+    double slack[4] = {1e-6, 3e-5, 1e-4, 1e-2};
+    size_t last = 0;
+    for (int k = 0; k < 4; k++) {
+        tk_strut_list tree = {0}, brute = {0};
+        double bound = shortest * (1.0 + slack[k]);
+        ck_assert_int_eq(tk_strut_finder_find(f, c, TK_ARC_ADMISSIBLE, 1.0, bound, &tree, &err),
+                         TK_OK);
+        ck_assert_int_eq(tk_struts_find_brute(c, TK_ARC_ADMISSIBLE, 1.0, bound, &brute, &err),
+                         TK_OK);
+        assert_same_lists(&tree, &brute, "stadium");
+        printf("stadium of %zu vertices: %zu struts within %g of the shortest\n", n, tree.count,
+               slack[k]);
+        ck_assert_uint_ge(tree.count, last > 0 ? last : 1);
+        last = tree.count;
+        tk_strut_list_free(&tree);
+        tk_strut_list_free(&brute);
+    }
+    double closest = 0.0;
+    ck_assert_int_eq(tk_strut_finder_closest_pair(f, c, TK_ARC_ADMISSIBLE, 1.0, 2.0, &closest,
+                                                  &err),
+                     TK_OK);
+    printf("stadium: closest pair %.17g, shortest strut by brute force %.17g\n", closest,
+           shortest);
+    ck_assert(closest == shortest);
+    tk_strut_finder_free(&f);
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(admissible_pairs_of_equilateral_polygon)
 {
     /* Theorem 3: on an equilateral polygon with edge l, pairs with fewer
@@ -250,6 +314,7 @@ int main(void)
     tcase_add_test(tc, tree_matches_brute_force_at_1000_vertices);
     tcase_add_test(tc, tree_matches_brute_force_at_10000_vertices);
     tcase_add_test(tc, tree_matches_brute_force_on_generated);
+    tcase_add_test(tc, tree_matches_brute_force_on_strands_side_by_side);
     tcase_add_test(tc, admissible_pairs_of_equilateral_polygon);
     tcase_add_test(tc, contact_at_shared_vertex_is_one_strut);
     tcase_add_test(tc, vertex_that_is_not_a_local_minimum_is_no_strut);
