@@ -9,7 +9,6 @@
 #include "run.h"
 #include "tk/geometry.h"
 
-#define MAX_CORRECTIONS 25
 /* The Newton steps are damped least-squares steps (tk/nnls.h): with more
  * violated struts than coordinates (a vertex near several edges of a
  * strand it touches along its length: the round Hopf link at 300 vertices
@@ -132,17 +131,18 @@ static size_t keep_violated(tk_run *r)
  * until the worst violation falls (near-dependent constraints can make the
  * regularised solution long); rescaling about the centroid is the last
  * resort, for leftovers up to rescale_up_to only. */
-static int correct(tk_run *r, double rescale_up_to, int *iterations, tk_error *err);
+static int correct(tk_run *r, int most, double rescale_up_to, int *iterations, tk_error *err);
 
-int tk_recovery_correct(tk_run *r, double rescale_up_to, int *iterations, tk_error *err)
+int tk_recovery_correct(tk_run *r, int most, double rescale_up_to, int *iterations,
+                        tk_error *err)
 {
     double t0 = tk_clock();
-    int rc = correct(r, rescale_up_to, iterations, err);
+    int rc = correct(r, most, rescale_up_to, iterations, err);
     r->recovery.seconds += tk_clock() - t0;
     return rc;
 }
 
-static int correct(tk_run *r, double rescale_up_to, int *iterations, tk_error *err)
+static int correct(tk_run *r, int most, double rescale_up_to, int *iterations, tk_error *err)
 {
     tk_curve *c = r->shared.curve, *t = r->shared.trial;
     tk_strut_finder *finder = r->shared.finder;
@@ -153,7 +153,7 @@ static int correct(tk_run *r, double rescale_up_to, int *iterations, tk_error *e
     tk_strut_finder_refit(finder, c);
     double worst;
     int rc = tk_recovery_violation(r, c, &worst, err);
-    for (int it = 0; !rc && worst > tk_tolerance_correction(r) && it < MAX_CORRECTIONS; it++) {
+    for (int it = 0; !rc && worst > tk_tolerance_correction(r) && it < most; it++) {
         rc = tk_active_find(r, c, set, err);
         if (!rc)
             rc = tk_grow_doubles(&r->recovery.rhs, &r->recovery.rhs_capacity,

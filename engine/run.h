@@ -267,12 +267,15 @@ void tk_stepping_reset(tk_run *r);
  * again: a curve equal to the last one checked is not searched twice. */
 int tk_recovery_violation(tk_run *r, const tk_curve *c, double *out, tk_error *err);
 /* Corrects the run's curve until no constraint is violated beyond the
- * correction tolerance (section 4.6); the finder is then fitted to it.
- * What the Newton steps leave is removed by rescaling the curve about its
+ * correction tolerance (section 4.6), with at most `most` Newton steps
+ * (TK_CORRECTIONS after a step); the finder is then fitted to it.  What
+ * the Newton steps leave is removed by rescaling the curve about its
  * centroid when it is at most rescale_up_to (a fraction of the bound);
  * otherwise the call fails with TK_ENUMERIC, the curve as the Newton steps
  * left it. */
-int tk_recovery_correct(tk_run *r, double rescale_up_to, int *iterations, tk_error *err);
+#define TK_CORRECTIONS 25
+int tk_recovery_correct(tk_run *r, int most, double rescale_up_to, int *iterations,
+                        tk_error *err);
 /* Rescaling the whole curve throws away its contacts (and at a violation
  * of a few percent, the work of minutes): after a step it only removes a
  * leftover this small, a feasibility fix; a step that needs more is undone

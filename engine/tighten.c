@@ -196,7 +196,7 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
     rep.rcond = 1.0;
     rep.residual = NAN;
     if (!rc)
-        rc = tk_recovery_correct(r, TK_RESCALE_START(r), &rep.corrections, err);
+        rc = tk_recovery_correct(r, TK_CORRECTIONS, TK_RESCALE_START(r), &rep.corrections, err);
     if (!rc)
         rc = tk_active_find(r, r->shared.curve, &r->active.set, err);
     if (!rc)
@@ -389,7 +389,7 @@ static int step(tk_run *r, tk_error *err)
         /* the last attempt may rescale as the start may */
         double up_to = attempt < STEP_ATTEMPTS - 1 ? TK_RESCALE_FEASIBILITY : TK_RESCALE_START(r);
         if (!rc && worst > 0.5 * tk_tolerance_overstep(r))
-            rc = tk_recovery_correct(r, up_to, &rep.corrections, err);
+            rc = tk_recovery_correct(r, TK_CORRECTIONS, up_to, &rep.corrections, err);
         if (rc != TK_ENUMERIC || attempt == STEP_ATTEMPTS - 1 || !(rep.step_size > 0.0))
             break;
         /* Newton steps could not restore the thickness: undo the step,
