@@ -17,6 +17,12 @@
  * it, twelve times in a row, before a rescaling took over; damped, two
  * steps restore it. */
 #define RECOVERY_DAMPING 1e-6
+/* Checks near the curve look this far at most (in diameters): a farther
+ * trial is checked with the tree.  The pairs are found for NEAR_AHEAD
+ * times the step's reach, so that the next steps, which start where this
+ * one ended, can use them too. */
+#define NEAR_REACH_MOST 1e-3
+#define NEAR_AHEAD 4.0
 
 void tk_recovery_free(tk_run *r)
 {
@@ -54,8 +60,10 @@ int tk_recovery_violation(tk_run *r, const tk_curve *c, double *out, tk_error *e
         r->recovery.check_seconds += tk_clock() - t0;
         return TK_OK;
     }
-    int rc = tk_strut_finder_closest_pair(r->shared.finder, c, TK_ARC_ADMISSIBLE, r->tau, r->tau,
-                                          &closest, err);
+    int rc = TK_OK;
+    if (!tk_strut_finder_closest_near(r->shared.finder, c, r->tau, &closest))
+        rc = tk_strut_finder_closest_pair(r->shared.finder, c, TK_ARC_ADMISSIBLE, r->tau,
+                                          r->tau, &closest, err);
     if (!rc) {
         double minrad = tk_curve_minrad(c, NULL);
         double v = fmax((r->tau - closest) / r->tau, (r->min_radius - minrad) / r->min_radius);
@@ -65,6 +73,21 @@ int tk_recovery_violation(tk_run *r, const tk_curve *c, double *out, tk_error *e
             r->recovery.checked_vertices = c->nvert;
             r->recovery.checked_worst = *out;
         }
+    }
+    r->recovery.check_seconds += tk_clock() - t0;
+    return rc;
+}
+
+int tk_recovery_near(tk_run *r, const double *motion, double h, double fastest, tk_error *err)
+{
+    double t0 = tk_clock();
+    int rc = TK_OK;
+    const tk_curve *c = r->shared.curve;
+    if (h * fastest <= NEAR_REACH_MOST * r->tau &&
+        !tk_strut_finder_near_covers(r->shared.finder, c, motion, h, TK_ARC_ADMISSIBLE, r->tau)) {
+        tk_strut_finder_refit(r->shared.finder, c);
+        double reach = fmin(NEAR_AHEAD * h * fastest, NEAR_REACH_MOST * r->tau);
+        rc = tk_strut_finder_near(r->shared.finder, c, TK_ARC_ADMISSIBLE, r->tau, reach, err);
     }
     r->recovery.check_seconds += tk_clock() - t0;
     return rc;

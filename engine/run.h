@@ -266,6 +266,13 @@ void tk_stepping_reset(tk_run *r);
  * accepts is the last trial it checked, and the step's figures check it
  * again: a curve equal to the last one checked is not searched twice. */
 int tk_recovery_violation(tk_run *r, const tk_curve *c, double *out, tk_error *err);
+/* Prepares the checks of the curves c + s h motion, 0 <= s <= 1 (a
+ * step's trial points; fastest the largest |motion| of a vertex): they
+ * look at the edge pairs near them alone (tk_strut_finder_near), with the
+ * same answers, and so do the corrections after it while they stay near.
+ * The pairs are found again only when the last ones do not cover those
+ * curves (the finder is then fitted to the run's curve). */
+int tk_recovery_near(tk_run *r, const double *motion, double h, double fastest, tk_error *err);
 /* Corrects the run's curve until no constraint is violated beyond the
  * correction tolerance (section 4.6), with at most `most` Newton steps
  * (TK_CORRECTIONS after a step); the finder is then fitted to it.  What

@@ -28,6 +28,15 @@ bool tk_stepping_stalled(const tk_run *r)
     return r->stepping.tiny_steps >= STALL_STEPS;
 }
 
+/* The largest |motion| of a vertex. */
+static double fastest(const tk_run *r)
+{
+    double most = 0.0;
+    for (size_t v = 0; v < r->shared.curve->nvert; v++)
+        most = fmax(most, tk_norm(r->motion.motion + 3 * v, 3));
+    return most;
+}
+
 /* No vertex may move more than a tenth of the diameter or a quarter of
  * the shortest edge in one step, so no strand can pass through another
  * between two checks and no edge folds over: the largest step size for the
@@ -35,14 +44,12 @@ bool tk_stepping_stalled(const tk_run *r)
 static double largest_step(const tk_run *r)
 {
     const tk_curve *c = r->shared.curve;
-    double fastest = 0.0;
-    for (size_t v = 0; v < c->nvert; v++)
-        fastest = fmax(fastest, tk_norm(r->motion.motion + 3 * v, 3));
-    if (!(fastest > 0.0))
+    double fastest_vertex = fastest(r);
+    if (!(fastest_vertex > 0.0))
         return 0.0;
     double shortest_edge;
     tk_curve_edge_range(c, &shortest_edge, NULL);
-    return fmin(0.1 * r->tau, 0.25 * shortest_edge) / fastest;
+    return fmin(0.1 * r->tau, 0.25 * shortest_edge) / fastest_vertex;
 }
 
 /* The largest step, halving from twice the last one, whose end point
@@ -66,6 +73,10 @@ static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *al
     }
     double h = r->stepping.step_size > 0.0 ? fmin(2.0 * r->stepping.step_size, largest)
                                            : largest / 8.0;
+    /* every trial of this motion moves a vertex by at most h |motion| */
+    int rc0 = tk_recovery_near(r, motion, h * (1.0 + 1e-9), fastest(r), err);
+    if (rc0)
+        return rc0;
     double length_before = tk_curve_length(c);
     int expansions = 0;
     for (int halving = 0; halving < MAX_HALVINGS; halving++, h *= 0.5) {
@@ -97,6 +108,9 @@ static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *al
                 if (!tk_motion_descends(r))
                     break;
                 h = 2.0 * fmin(h, largest); /* undo this iteration's halving */
+                rc = tk_recovery_near(r, motion, h * (1.0 + 1e-9), fastest(r), err);
+                if (rc)
+                    return rc;
                 continue;
             }
         }

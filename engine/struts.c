@@ -65,6 +65,14 @@ struct tk_strut_finder {
     tree_node *nodes;
     size_t nnodes;
     edge_frame *frames;       /* per edge, of the curve last fitted */
+    /* tk_strut_finder_near: the pairs for checks near a curve */
+    size_t *near;             /* pairs of global edges, i < j */
+    size_t nnear, near_capacity;
+    double *near_of;          /* 3V: the curve */
+    double *near_prefix;      /* its arc-rule sums (as prefix) */
+    double near_reach;        /* 0: no pairs */
+    double near_tau;
+    tk_arc_rule near_rule;
 };
 
 /* The state of one query. */
@@ -78,6 +86,8 @@ typedef struct query {
     tk_strut best;
     tk_strut_list *out;
     int status;
+    double arc_slack;         /* the arc rule relaxed by this turn */
+    bool near;                /* collect every pair into f->near */
 } query;
 
 void tk_strut_list_clear(tk_strut_list *list)
@@ -123,6 +133,9 @@ void tk_strut_finder_free(tk_strut_finder **p)
     free(f->prefix_offset);
     free(f->nodes);
     free(f->frames);
+    free(f->near);
+    free(f->near_of);
+    free(f->near_prefix);
     free(f);
     *p = NULL;
 }
@@ -302,8 +315,10 @@ static bool edges_adjacent(const tk_strut_finder *f, size_t i, size_t j)
     return f->next[i] == j || f->prev[i] == j;
 }
 
-/* The arc rule for global edges i != j (prefix must be filled). */
-static bool pair_allowed(const tk_strut_finder *f, const tk_curve *c, size_t i, size_t j)
+/* The arc rule for global edges i != j (prefix must be filled), relaxed
+ * by a turn of `slack`. */
+static bool pair_allowed_by(const tk_strut_finder *f, const tk_curve *c, size_t i, size_t j,
+                            double slack)
 {
     if (f->comp[i] != f->comp[j])
         return true;
@@ -317,17 +332,22 @@ static bool pair_allowed(const tk_strut_finder *f, const tk_curve *c, size_t i, 
         b = t;
     }
     double fwd = forward_turn(f, comp, a, b);
-    if (fwd < ARC_TURN_NEEDED)
+    if (fwd < ARC_TURN_NEEDED - slack)
         return false;
     if (!f->comp_closed[comp])
         return true;
-    return comp_total_turn(f, c, comp) - fwd >= ARC_TURN_NEEDED;
+    return comp_total_turn(f, c, comp) - fwd >= ARC_TURN_NEEDED - slack;
+}
+
+static bool pair_allowed(const tk_strut_finder *f, const tk_curve *c, size_t i, size_t j)
+{
+    return pair_allowed_by(f, c, i, j, 0.0);
 }
 
 /* Whether some pair of edges of the two nodes may pass the arc rule: an
  * upper bound of min(forward, backward) turn over the node pair. */
 static bool nodes_may_pass(const tk_strut_finder *f, const tk_curve *c,
-                           const tree_node *x, const tree_node *y)
+                           const tree_node *x, const tree_node *y, double slack)
 {
     if (x->comp == NO_COMP || y->comp == NO_COMP || x->comp != y->comp)
         return true;
@@ -337,7 +357,7 @@ static bool nodes_may_pass(const tk_strut_finder *f, const tk_curve *c,
     size_t lo0 = x0 < y0 ? x0 : y0, hi1 = x1 > y1 ? x1 : y1;
     /* Largest forward turn: from the first edge of either node to the last. */
     double max_fwd = lo0 < hi1 ? forward_turn(f, comp, lo0, hi1) : 0.0;
-    if (max_fwd < ARC_TURN_NEEDED)
+    if (max_fwd < ARC_TURN_NEEDED - slack)
         return false;
     if (!f->comp_closed[comp])
         return true;
@@ -347,7 +367,7 @@ static bool nodes_may_pass(const tk_strut_finder *f, const tk_curve *c,
         min_fwd = forward_turn(f, comp, x1, y0);
     else if (y1 < x0)
         min_fwd = forward_turn(f, comp, y1, x0);
-    return comp_total_turn(f, c, comp) - min_fwd >= ARC_TURN_NEEDED;
+    return comp_total_turn(f, c, comp) - min_fwd >= ARC_TURN_NEEDED - slack;
 }
 
 static void edge_closest(const tk_strut_finder *f, const tk_curve *c, size_t i,
@@ -459,12 +479,28 @@ static bool pair_beyond(const tk_strut_finder *f, size_t i, size_t j, double b2)
 static void test_pair(query *qy, size_t i, size_t j)
 {
     tk_strut_finder *f = qy->f;
-    if (!pair_allowed(f, qy->c, i, j))
+    if (!pair_allowed_by(f, qy->c, i, j, qy->arc_slack))
         return;
     tk_closest cl;
     edge_closest(f, qy->c, i, j, &cl);
     if (qy->shortest_mode ? !(cl.dist < qy->bound) : !(cl.dist <= qy->bound))
         return;
+    if (qy->near) {
+        if (f->nnear == f->near_capacity) {
+            size_t cap = f->near_capacity ? 2 * f->near_capacity : 256;
+            size_t *grown = realloc(f->near, 2 * cap * sizeof *grown);
+            if (!grown) {
+                qy->status = TK_ENOMEM;
+                return;
+            }
+            f->near = grown;
+            f->near_capacity = cap;
+        }
+        f->near[2 * f->nnear] = i;
+        f->near[2 * f->nnear + 1] = j;
+        f->nnear++;
+        return;
+    }
     if (!qy->plain || qy->out) {
         /* Listing pairs without the local-minimum test still leaves out
          * the pairs that merely repeat a contact another pair reports:
@@ -501,7 +537,7 @@ static bool node_pair_pruned(const query *qy, const tree_node *x, const tree_nod
     double b2 = qy->bound * qy->bound;
     if (qy->shortest_mode ? g2 >= b2 : g2 > b2)
         return true;
-    return !nodes_may_pass(qy->f, qy->c, x, y);
+    return !nodes_may_pass(qy->f, qy->c, x, y, qy->arc_slack);
 }
 
 static void visit(query *qy, size_t xi, size_t yi)
@@ -685,6 +721,101 @@ int tk_strut_finder_closest_pair(tk_strut_finder *f, const tk_curve *c, tk_arc_r
         visit(&qy, 0, 0);
     *dist = qy.bound;
     return TK_OK;
+}
+
+/* The arc rule's sums change with the curve (they add up turns bounded
+ * by the edge lengths): the pairs are found with the rule relaxed by
+ * NEAR_ARC_SLACK, and a curve whose turns between two vertices may differ
+ * from c's by more than half of it is checked by the tree instead. */
+#define NEAR_ARC_SLACK 0.05
+
+int tk_strut_finder_near(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule, double tau,
+                         double reach, tk_error *err)
+{
+    f->near_reach = 0.0;
+    f->nnear = 0;
+    int rc = begin_query(f, c, rule, tau, err);
+    if (rc)
+        return rc;
+    size_t nsums = c->nvert + c->ncomp;
+    if (!f->near_of) {
+        f->near_of = malloc(3 * c->nvert * sizeof *f->near_of);
+        f->near_prefix = malloc(nsums * sizeof *f->near_prefix);
+        if (!f->near_of || !f->near_prefix)
+            return tk_error_set(err, TK_ENOMEM, "out of memory for near pairs");
+    }
+    /* (the margin is far above the rounding of a distance) */
+    double bound = (tau + 2.0 * reach) * (1.0 + 1e-9);
+    query qy = {f, c, rule, bound, false, true, {{0}}, NULL, TK_OK, NEAR_ARC_SLACK, true};
+    if (f->nedges > 1)
+        visit(&qy, 0, 0);
+    if (qy.status != TK_OK) {
+        f->nnear = 0;
+        return tk_error_set(err, qy.status, "out of memory for near pairs");
+    }
+    memcpy(f->near_of, c->xyz, 3 * c->nvert * sizeof *c->xyz);
+    memcpy(f->near_prefix, f->prefix, nsums * sizeof *f->prefix);
+    f->near_reach = reach;
+    f->near_tau = tau;
+    f->near_rule = rule;
+    return TK_OK;
+}
+
+bool tk_strut_finder_near_covers(const tk_strut_finder *f, const tk_curve *c, const double *motion,
+                                 double h, tk_arc_rule rule, double tau)
+{
+    if (!(f->near_reach > 0.0) || f->near_rule != rule || f->near_tau != tau ||
+        c->nvert != f->nvert)
+        return false;
+    for (size_t v = 0; v < c->nvert; v++) {
+        const double *p = c->xyz + 3 * v, *q = f->near_of + 3 * v, *m = motion + 3 * v;
+        double d[3] = {p[0] - q[0], p[1] - q[1], p[2] - q[2]};
+        if (sqrt(tk_dot3(d, d)) + h * sqrt(tk_dot3(m, m)) > f->near_reach)
+            return false;
+    }
+    return true;
+}
+
+bool tk_strut_finder_closest_near(tk_strut_finder *f, const tk_curve *t, double below,
+                                  double *dist)
+{
+    if (!(f->near_reach > 0.0) || !(below <= f->near_tau) || check_counts(f, t, NULL) != TK_OK)
+        return false;
+    double reach2 = f->near_reach * f->near_reach;
+    for (size_t v = 0; v < t->nvert; v++) {
+        const double *p = t->xyz + 3 * v, *q = f->near_of + 3 * v;
+        double d[3] = {p[0] - q[0], p[1] - q[1], p[2] - q[2]};
+        if (tk_dot3(d, d) > reach2)
+            return false;
+    }
+    fill_prefix(f, t, f->near_rule, f->near_tau);
+    /* a forward turn (and the rest of a closed component's) changed by at
+     * most twice the range of the sums' change */
+    for (size_t k = 0; k < t->ncomp; k++) {
+        const double *now = f->prefix + f->prefix_offset[k];
+        const double *then = f->near_prefix + f->prefix_offset[k];
+        double lo = 0.0, hi = 0.0;
+        for (size_t i = 0; i <= tk_curve_comp_vertices(t, k); i++) {
+            lo = fmin(lo, now[i] - then[i]);
+            hi = fmax(hi, now[i] - then[i]);
+        }
+        if (2.0 * (hi - lo) > 0.5 * NEAR_ARC_SLACK)
+            return false;
+    }
+    /* as tk_strut_finder_closest_pair: the least distance below `below`
+     * among the pairs the arc rule allows at t */
+    double least = below;
+    for (size_t k = 0; k < f->nnear; k++) {
+        size_t i = f->near[2 * k], j = f->near[2 * k + 1];
+        if (!pair_allowed(f, t, i, j))
+            continue;
+        tk_closest cl;
+        edge_closest(f, t, i, j, &cl);
+        if (cl.dist < least)
+            least = cl.dist;
+    }
+    *dist = least;
+    return true;
 }
 
 int tk_struts_find_brute(const tk_curve *c, tk_arc_rule rule, double tau, double bound,

@@ -129,9 +129,9 @@ END_TEST
  * (struts.c, pair_beyond) must drop those and no other.  Struts and the
  * closest pair against brute force at bounds 1e-6 to 1e-2 above the
  * shortest. */
-START_TEST(tree_matches_brute_force_on_strands_side_by_side)
+static tk_curve *stadium(size_t n)
 {
-    size_t n = 2000, counts[1] = {n};
+    size_t counts[1] = {n};
     bool closed[1] = {true};
     tk_curve *c = NULL;
     ck_assert_int_eq(tk_curve_new(&c, 1, counts, closed, NULL), TK_OK);
@@ -152,6 +152,13 @@ START_TEST(tree_matches_brute_force_on_strands_side_by_side)
         p[1] += 5e-5 * cos(1.7 * (double)k);
         p[2] = 1e-4 * sin(2.39996 * (double)k);
     }
+    return c;
+}
+
+START_TEST(tree_matches_brute_force_on_strands_side_by_side)
+{
+    size_t n = 2000;
+    tk_curve *c = stadium(n);
     tk_strut_finder *f = NULL;
     tk_error err;
     ck_assert_int_eq(tk_strut_finder_new(c, &f, &err), TK_OK);
@@ -181,6 +188,68 @@ START_TEST(tree_matches_brute_force_on_strands_side_by_side)
            shortest);
     ck_assert(closest == shortest);
     tk_strut_finder_free(&f);
+    tk_curve_free(&c);
+}
+END_TEST
+
+/* Checks near a curve (tk_strut_finder_near) give the tree's closest
+ * pair exactly, on the stadium above: its caps are half circles of
+ * diameter 1, so pairs across them sit at the arc rule's edge (a turn of
+ * pi) at distance about 1, and moving the curve changes which of them the
+ * rule allows.  Smooth displacements of every vertex by up to the reach
+ * (a few waves along the curve, as a step's motion), at bounds below and
+ * above the closest pair; a curve farther than the reach, or one whose
+ * edges all change length (rough noise), is declined. */
+START_TEST(near_checks_equal_the_tree)
+{
+    size_t n = 2000;
+    tk_curve *c = stadium(n), *t = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_curve_copy(c, &t, &err), TK_OK);
+    tk_strut_finder *f = NULL;
+    ck_assert_int_eq(tk_strut_finder_new(c, &f, &err), TK_OK);
+    double reach = 2e-3;
+    ck_assert_int_eq(tk_strut_finder_near(f, c, TK_ARC_ADMISSIBLE, 1.0, reach, &err), TK_OK);
+    int compared = 0, below = 0;
+    for (int trial = 0; trial < 40; trial++) {
+        double phase = 0.7 * trial, waves = 1 + trial % 5, size = reach * (0.2 + 0.02 * trial);
+        for (size_t v = 0; v < n; v++) {
+            double a = 2.0 * M_PI * waves * (double)v / (double)n;
+            double d[3] = {cos(a + phase), sin(2.0 * a - phase), cos(3.0 * a + 2.0 * phase)};
+            double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            for (int k = 0; k < 3; k++)
+                t->xyz[3 * v + k] = c->xyz[3 * v + k] + size * d[k] / fmax(len, 1.0);
+        }
+        tk_strut_finder_refit(f, t);
+        for (int b = 0; b < 2; b++) {
+            double limit = b ? 1.0 : 0.995;
+            double tree = 0.0, near = -1.0;
+            ck_assert_int_eq(tk_strut_finder_closest_pair(f, t, TK_ARC_ADMISSIBLE, 1.0, limit,
+                                                          &tree, &err),
+                             TK_OK);
+            if (!tk_strut_finder_closest_near(f, t, limit, &near))
+                continue;
+            ck_assert_msg(near == tree, "trial %d: near %.17g, tree %.17g", trial, near, tree);
+            compared++;
+            below += tree < limit;
+        }
+    }
+    printf("near checks: %d of 80 compared, %d of them below the bound\n", compared, below);
+    ck_assert_int_ge(compared, 60);
+    ck_assert_int_ge(below, 20);
+    /* too far: one vertex beyond the reach */
+    memcpy(t->xyz, c->xyz, 3 * n * sizeof *t->xyz);
+    t->xyz[3 * 500 + 2] += 1.01 * reach;
+    double near = -1.0;
+    ck_assert(!tk_strut_finder_closest_near(f, t, 1.0, &near));
+    /* rough: every edge a little longer or shorter */
+    for (size_t v = 0; v < n; v++)
+        for (int k = 0; k < 3; k++)
+            t->xyz[3 * v + k] = c->xyz[3 * v + k] + 0.5 * reach * ((v + k) % 2 ? 1.0 : -1.0);
+    ck_assert(!tk_strut_finder_closest_near(f, t, 1.0, &near));
+    ck_assert(near == -1.0);
+    tk_strut_finder_free(&f);
+    tk_curve_free(&t);
     tk_curve_free(&c);
 }
 END_TEST
@@ -315,6 +384,7 @@ int main(void)
     tcase_add_test(tc, tree_matches_brute_force_at_10000_vertices);
     tcase_add_test(tc, tree_matches_brute_force_on_generated);
     tcase_add_test(tc, tree_matches_brute_force_on_strands_side_by_side);
+    tcase_add_test(tc, near_checks_equal_the_tree);
     tcase_add_test(tc, admissible_pairs_of_equilateral_polygon);
     tcase_add_test(tc, contact_at_shared_vertex_is_one_strut);
     tcase_add_test(tc, vertex_that_is_not_a_local_minimum_is_no_strut);

@@ -111,6 +111,26 @@ int tk_strut_finder_shortest(tk_strut_finder *f, const tk_curve *c,
 int tk_strut_finder_closest_pair(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule,
                                  double tau, double below, double *dist, tk_error *err);
 
+/* For checks of curves near c, each vertex within `reach` of c's (the
+ * trial points of a step): an edge pair's distance there differs from
+ * c's by at most 2 reach, so only the pairs closer than tau + 2 reach at
+ * c (and allowed by the arc rule, which changes with the curve) can be
+ * below tau.  Finds them once (the finder fitted to c).  Replaces the
+ * last such list. */
+int tk_strut_finder_near(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule, double tau,
+                         double reach, tk_error *err);
+/* Whether the last list of tk_strut_finder_near (with this rule and tau)
+ * covers every curve c + s h motion, 0 <= s <= 1 (motion 3V). */
+bool tk_strut_finder_near_covers(const tk_strut_finder *f, const tk_curve *c, const double *motion,
+                                 double h, tk_arc_rule rule, double tau);
+/* tk_strut_finder_closest_pair(f, t, rule, tau, below, dist) with the
+ * rule and tau of the last tk_strut_finder_near, from its pairs alone:
+ * the same answer, for below <= tau.  False (and *dist untouched) when t
+ * is not near enough its curve to tell; the finder need not be fitted
+ * to t. */
+bool tk_strut_finder_closest_near(tk_strut_finder *f, const tk_curve *t, double below,
+                                  double *dist);
+
 /* The same answers by checking every pair of edges: O(V^2), for tests and
  * for comparison in benchmarks. */
 int tk_struts_find_brute(const tk_curve *c, tk_arc_rule rule, double tau,
