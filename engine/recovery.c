@@ -20,7 +20,8 @@
 /* Checks near the curve look this far at most (in diameters): a farther
  * trial is checked with the tree.  The pairs are found for NEAR_AHEAD
  * times the step's reach, so that the next steps, which start where this
- * one ended, can use them too. */
+ * one ended, can use them too, and found again when that is more than
+ * NEAR_AHEAD times what a step needs (the list grows with the reach). */
 #define NEAR_REACH_MOST 1e-3
 #define NEAR_AHEAD 4.0
 
@@ -83,10 +84,13 @@ int tk_recovery_near(tk_run *r, const double *motion, double h, double fastest, 
     double t0 = tk_clock();
     int rc = TK_OK;
     const tk_curve *c = r->shared.curve;
+    /* (and the active set's search at the next step's start) */
+    double need = fmax(h * fastest, tk_tolerance_active(r) * r->tau);
     if (h * fastest <= NEAR_REACH_MOST * r->tau &&
-        !tk_strut_finder_near_covers(r->shared.finder, c, motion, h, TK_ARC_ADMISSIBLE, r->tau)) {
+        !tk_strut_finder_near_covers(r->shared.finder, c, motion, h,
+                                     NEAR_AHEAD * NEAR_AHEAD * need, TK_ARC_ADMISSIBLE, r->tau)) {
         tk_strut_finder_refit(r->shared.finder, c);
-        double reach = fmin(NEAR_AHEAD * h * fastest, NEAR_REACH_MOST * r->tau);
+        double reach = fmin(NEAR_AHEAD * need, NEAR_REACH_MOST * r->tau);
         rc = tk_strut_finder_near(r->shared.finder, c, TK_ARC_ADMISSIBLE, r->tau, reach, err);
     }
     r->recovery.check_seconds += tk_clock() - t0;

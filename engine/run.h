@@ -269,7 +269,8 @@ int tk_recovery_violation(tk_run *r, const tk_curve *c, double *out, tk_error *e
 /* Prepares the checks of the curves c + s h motion, 0 <= s <= 1 (a
  * step's trial points; fastest the largest |motion| of a vertex): they
  * look at the edge pairs near them alone (tk_strut_finder_near), with the
- * same answers, and so do the corrections after it while they stay near.
+ * same answers, and so do the corrections after it and the next active
+ * set's search while they stay near.
  * The pairs are found again only when the last ones do not cover those
  * curves (the finder is then fitted to the run's curve). */
 int tk_recovery_near(tk_run *r, const double *motion, double h, double fastest, tk_error *err);

@@ -627,6 +627,9 @@ static int begin_query(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule, 
     return TK_OK;
 }
 
+static bool find_near(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule, double tau,
+                      double bound, bool plain, tk_strut_list *out, int *status);
+
 static int find_pairs(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule, double tau,
                       double bound, bool plain, tk_strut_list *out, tk_error *err)
 {
@@ -634,11 +637,15 @@ static int find_pairs(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule, d
     if (rc)
         return rc;
     size_t start = out->count;
-    query qy = {f, c, rule, bound, false, plain, {{0}}, out, TK_OK};
-    if (f->nedges > 1 && bound >= 0.0)
-        visit(&qy, 0, 0);
-    if (qy.status != TK_OK)
-        return tk_error_set(err, qy.status, "out of memory listing struts");
+    int status = TK_OK;
+    if (!find_near(f, c, rule, tau, bound, plain, out, &status)) {
+        query qy = {f, c, rule, bound, false, plain, {{0}}, out, TK_OK};
+        if (f->nedges > 1 && bound >= 0.0)
+            visit(&qy, 0, 0);
+        status = qy.status;
+    }
+    if (status != TK_OK)
+        return tk_error_set(err, status, "out of memory listing struts");
     if (out->count > start)
         qsort(out->items + start, out->count - start, sizeof *out->items,
               tk_strut_compare_edges);
@@ -762,10 +769,10 @@ int tk_strut_finder_near(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule
 }
 
 bool tk_strut_finder_near_covers(const tk_strut_finder *f, const tk_curve *c, const double *motion,
-                                 double h, tk_arc_rule rule, double tau)
+                                 double h, double most, tk_arc_rule rule, double tau)
 {
-    if (!(f->near_reach > 0.0) || f->near_rule != rule || f->near_tau != tau ||
-        c->nvert != f->nvert)
+    if (!(f->near_reach > 0.0) || f->near_reach > most || f->near_rule != rule ||
+        f->near_tau != tau || c->nvert != f->nvert)
         return false;
     for (size_t v = 0; v < c->nvert; v++) {
         const double *p = c->xyz + 3 * v, *q = f->near_of + 3 * v, *m = motion + 3 * v;
@@ -776,16 +783,22 @@ bool tk_strut_finder_near_covers(const tk_strut_finder *f, const tk_curve *c, co
     return true;
 }
 
-bool tk_strut_finder_closest_near(tk_strut_finder *f, const tk_curve *t, double below,
-                                  double *dist)
+/* Whether the last near pairs hold every pair of t (the finder's rule
+ * and tau) closer than `bound`: t's vertices are near enough theirs, and
+ * its arc rule's turns changed too little to admit a pair they left out.
+ * Fills the arc rule's sums for t. */
+static bool near_holds(tk_strut_finder *f, const tk_curve *t, double bound)
 {
-    if (!(f->near_reach > 0.0) || !(below <= f->near_tau) || check_counts(f, t, NULL) != TK_OK)
+    if (!(f->near_reach > 0.0) || check_counts(f, t, NULL) != TK_OK)
         return false;
-    double reach2 = f->near_reach * f->near_reach;
+    /* a distance changes by at most twice the farthest a vertex moved */
+    double room = 0.5 * (f->near_tau + 2.0 * f->near_reach - bound);
+    if (!(room >= 0.0))
+        return false;
     for (size_t v = 0; v < t->nvert; v++) {
         const double *p = t->xyz + 3 * v, *q = f->near_of + 3 * v;
         double d[3] = {p[0] - q[0], p[1] - q[1], p[2] - q[2]};
-        if (tk_dot3(d, d) > reach2)
+        if (tk_dot3(d, d) > room * room)
             return false;
     }
     fill_prefix(f, t, f->near_rule, f->near_tau);
@@ -802,6 +815,14 @@ bool tk_strut_finder_closest_near(tk_strut_finder *f, const tk_curve *t, double 
         if (2.0 * (hi - lo) > 0.5 * NEAR_ARC_SLACK)
             return false;
     }
+    return true;
+}
+
+bool tk_strut_finder_closest_near(tk_strut_finder *f, const tk_curve *t, double below,
+                                  double *dist)
+{
+    if (!(below <= f->near_tau) || !near_holds(f, t, below))
+        return false;
     /* as tk_strut_finder_closest_pair: the least distance below `below`
      * among the pairs the arc rule allows at t */
     double least = below;
@@ -815,6 +836,22 @@ bool tk_strut_finder_closest_near(tk_strut_finder *f, const tk_curve *t, double 
             least = cl.dist;
     }
     *dist = least;
+    return true;
+}
+
+/* find_pairs from the near pairs, when they hold every pair it needs:
+ * each goes through test_pair as the tree's would, and the tree prunes
+ * only pairs farther than the bound, so the list is the same.  False
+ * (nothing appended) when they do not. */
+static bool find_near(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule, double tau,
+                      double bound, bool plain, tk_strut_list *out, int *status)
+{
+    if (f->near_rule != rule || f->near_tau != tau || !near_holds(f, c, bound))
+        return false;
+    query qy = {f, c, rule, bound, false, plain, {{0}}, out, TK_OK};
+    for (size_t k = 0; k < f->nnear && qy.status == TK_OK; k++)
+        test_pair(&qy, f->near[2 * k], f->near[2 * k + 1]);
+    *status = qy.status;
     return true;
 }
 

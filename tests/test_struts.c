@@ -193,7 +193,7 @@ START_TEST(tree_matches_brute_force_on_strands_side_by_side)
 END_TEST
 
 /* Checks near a curve (tk_strut_finder_near) give the tree's closest
- * pair exactly, on the stadium above: its caps are half circles of
+ * pair, struts and pairs near contacts exactly, on the stadium above: its caps are half circles of
  * diameter 1, so pairs across them sit at the arc rule's edge (a turn of
  * pi) at distance about 1, and moving the curve changes which of them the
  * rule allows.  Smooth displacements of every vertex by up to the reach
@@ -206,8 +206,10 @@ START_TEST(near_checks_equal_the_tree)
     tk_curve *c = stadium(n), *t = NULL;
     tk_error err;
     ck_assert_int_eq(tk_curve_copy(c, &t, &err), TK_OK);
-    tk_strut_finder *f = NULL;
+    tk_strut_finder *f = NULL, *plain = NULL;
     ck_assert_int_eq(tk_strut_finder_new(c, &f, &err), TK_OK);
+    ck_assert_int_eq(tk_strut_finder_new(c, &plain, &err), TK_OK);
+    size_t listed = 0;
     double reach = 2e-3;
     ck_assert_int_eq(tk_strut_finder_near(f, c, TK_ARC_ADMISSIBLE, 1.0, reach, &err), TK_OK);
     int compared = 0, below = 0;
@@ -221,6 +223,21 @@ START_TEST(near_checks_equal_the_tree)
                 t->xyz[3 * v + k] = c->xyz[3 * v + k] + size * d[k] / fmax(len, 1.0);
         }
         tk_strut_finder_refit(f, t);
+        tk_strut_finder_refit(plain, t);
+        /* the struts and the pairs near contacts, from the near pairs
+         * (f) and from the tree alone (plain) */
+        for (int pairs = 0; pairs < 2; pairs++) {
+            tk_strut_list a = {0}, b = {0};
+            int (*find)(tk_strut_finder *, const tk_curve *, tk_arc_rule, double, double,
+                        tk_strut_list *, tk_error *) =
+                pairs ? tk_strut_finder_find_pairs : tk_strut_finder_find;
+            ck_assert_int_eq(find(f, t, TK_ARC_ADMISSIBLE, 1.0, 1.0 + 1e-4, &a, &err), TK_OK);
+            ck_assert_int_eq(find(plain, t, TK_ARC_ADMISSIBLE, 1.0, 1.0 + 1e-4, &b, &err), TK_OK);
+            assert_same_lists(&a, &b, "near pairs");
+            listed += a.count;
+            tk_strut_list_free(&a);
+            tk_strut_list_free(&b);
+        }
         for (int b = 0; b < 2; b++) {
             double limit = b ? 1.0 : 0.995;
             double tree = 0.0, near = -1.0;
@@ -234,7 +251,10 @@ START_TEST(near_checks_equal_the_tree)
             below += tree < limit;
         }
     }
-    printf("near checks: %d of 80 compared, %d of them below the bound\n", compared, below);
+    printf("near checks: %d of 80 compared, %d of them below the bound; %zu struts and "
+           "pairs listed\n",
+           compared, below, listed);
+    ck_assert_uint_gt(listed, 1000);
     ck_assert_int_ge(compared, 60);
     ck_assert_int_ge(below, 20);
     /* too far: one vertex beyond the reach */
@@ -249,6 +269,7 @@ START_TEST(near_checks_equal_the_tree)
     ck_assert(!tk_strut_finder_closest_near(f, t, 1.0, &near));
     ck_assert(near == -1.0);
     tk_strut_finder_free(&f);
+    tk_strut_finder_free(&plain);
     tk_curve_free(&t);
     tk_curve_free(&c);
 }

@@ -116,13 +116,16 @@ int tk_strut_finder_closest_pair(tk_strut_finder *f, const tk_curve *c, tk_arc_r
  * c's by at most 2 reach, so only the pairs closer than tau + 2 reach at
  * c (and allowed by the arc rule, which changes with the curve) can be
  * below tau.  Finds them once (the finder fitted to c).  Replaces the
- * last such list. */
+ * last such list.  While they hold every pair a query needs (its curve
+ * near enough c), tk_strut_finder_find and _find_pairs look at them
+ * instead of the tree, to the same answer. */
 int tk_strut_finder_near(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule, double tau,
                          double reach, tk_error *err);
-/* Whether the last list of tk_strut_finder_near (with this rule and tau)
- * covers every curve c + s h motion, 0 <= s <= 1 (motion 3V). */
+/* Whether the last list of tk_strut_finder_near (with this rule and tau,
+ * and a reach of at most `most`) covers every curve c + s h motion,
+ * 0 <= s <= 1 (motion 3V). */
 bool tk_strut_finder_near_covers(const tk_strut_finder *f, const tk_curve *c, const double *motion,
-                                 double h, tk_arc_rule rule, double tau);
+                                 double h, double most, tk_arc_rule rule, double tau);
 /* tk_strut_finder_closest_pair(f, t, rule, tau, below, dist) with the
  * rule and tau of the last tk_strut_finder_near, from its pairs alone:
  * the same answer, for below <= tau.  False (and *dist untouched) when t
