@@ -745,12 +745,12 @@ int tk_strut_finder_near(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule
     if (rc)
         return rc;
     size_t nsums = c->nvert + c->ncomp;
-    if (!f->near_of) {
+    if (!f->near_of)
         f->near_of = malloc(3 * c->nvert * sizeof *f->near_of);
+    if (!f->near_prefix)
         f->near_prefix = malloc(nsums * sizeof *f->near_prefix);
-        if (!f->near_of || !f->near_prefix)
-            return tk_error_set(err, TK_ENOMEM, "out of memory for near pairs");
-    }
+    if (!f->near_of || !f->near_prefix)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for near pairs");
     /* (the margin is far above the rounding of a distance) */
     double bound = (tau + 2.0 * reach) * (1.0 + 1e-9);
     query qy = {f, c, rule, bound, false, true, {{0}}, NULL, TK_OK, NEAR_ARC_SLACK, true};
