@@ -64,6 +64,14 @@ n_struts=$(value struts "$tmp/result.json")
 [ "$(grep -o '"force"' "$tmp/struts.json" | wc -l)" -ge "$n_struts" ]
 check $? "struts file lists forces for $n_struts struts"
 
+# the text summary says what error recovery's last resorts did: this
+# start (loose once autoscaled) needs neither an undone step nor a rescale
+"$tk" tighten "$tmp/trefoil.vect" --autoscale --steps 40 >"$tmp/summary.txt" 2>"$tmp/err"
+check $? "tighten (text) exits 0: $(cat "$tmp/err")"
+grep -q "^  recovery: 0 steps undone and taken shorter, 0 rescales after a step$" \
+    "$tmp/summary.txt"
+check $? "the summary's recovery line: $(grep recovery "$tmp/summary.txt")"
+
 # --re-resolve keeps the resolution as the knot tightens: fewer vertices
 # at the end than at the start, about resolution * ropelength of them
 "$tk" tighten "$tmp/trefoil.vect" --autoscale --resolution 5 --re-resolve 0.05 --steps 300 \
