@@ -68,7 +68,7 @@ check $? "struts file lists forces for $n_struts struts"
 # start (loose once autoscaled) needs neither an undone step nor a rescale
 "$tk" tighten "$tmp/trefoil.vect" --autoscale --steps 40 >"$tmp/summary.txt" 2>"$tmp/err"
 check $? "tighten (text) exits 0: $(cat "$tmp/err")"
-grep -q "^  recovery: 0 steps undone and taken shorter, 0 rescales after a step$" \
+grep -q "^  recovery: 0 steps undone and taken shorter, 0 rescales of the whole curve$" \
     "$tmp/summary.txt"
 check $? "the summary's recovery line: $(grep recovery "$tmp/summary.txt")"
 

@@ -864,7 +864,7 @@ static int cmd_tighten(int argc, char **argv)
         putchar('\n');
         tk_run_timing t;
         tk_run_timing_get(run, &t);
-        printf("  recovery: %ld steps undone and taken shorter, %ld rescales after a step",
+        printf("  recovery: %ld steps undone and taken shorter, %ld rescales of the whole curve",
                t.undone_steps, t.rescales);
         if (t.rescales > 0)
             printf(" (largest by a factor 1 + %.3g)", t.largest_rescale);
