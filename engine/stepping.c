@@ -40,15 +40,14 @@ static double fastest(const tk_run *r)
 /* No vertex may move more than a tenth of the diameter or a quarter of
  * the shortest edge in one step, so no strand can pass through another
  * between two checks and no edge folds over: the largest step size for the
- * current motion (0 when nothing moves). */
-static double largest_step(const tk_run *r)
+ * current motion, whose fastest vertex moves at fastest_vertex (0 when
+ * nothing moves). */
+static double largest_step(const tk_run *r, double fastest_vertex)
 {
-    const tk_curve *c = r->shared.curve;
-    double fastest_vertex = fastest(r);
     if (!(fastest_vertex > 0.0))
         return 0.0;
     double shortest_edge;
-    tk_curve_edge_range(c, &shortest_edge, NULL);
+    tk_curve_edge_range(r->shared.curve, &shortest_edge, NULL);
     return fmin(0.1 * r->tau, 0.25 * shortest_edge) / fastest_vertex;
 }
 
@@ -64,7 +63,7 @@ static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *al
     tk_strut_finder *finder = r->shared.finder;
     const double *motion = r->motion.motion;
     size_t n3 = 3 * c->nvert;
-    double largest = largest_step(r);
+    double fast = fastest(r), largest = largest_step(r, fast);
     *allowed = largest;
     if (!(largest > 0.0) || !tk_motion_descends(r)) {
         rep->step_size = 0.0;
@@ -74,7 +73,7 @@ static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *al
     double h = r->stepping.step_size > 0.0 ? fmin(2.0 * r->stepping.step_size, largest)
                                            : largest / 8.0;
     /* every trial of this motion moves a vertex by at most h |motion| */
-    int rc0 = tk_recovery_near(r, motion, h * (1.0 + 1e-9), fastest(r), err);
+    int rc0 = tk_recovery_near(r, motion, h * (1.0 + 1e-9), fast, err);
     if (rc0)
         return rc0;
     double length_before = tk_curve_length(c);
@@ -103,12 +102,13 @@ static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *al
                 rc = tk_motion_resolve(r, rep, equalising, err);
                 if (rc)
                     return rc;
-                largest = largest_step(r);
+                fast = fastest(r);
+                largest = largest_step(r, fast);
                 *allowed = largest;
                 if (!tk_motion_descends(r))
                     break;
                 h = 2.0 * fmin(h, largest); /* undo this iteration's halving */
-                rc = tk_recovery_near(r, motion, h * (1.0 + 1e-9), fastest(r), err);
+                rc = tk_recovery_near(r, motion, h * (1.0 + 1e-9), fast, err);
                 if (rc)
                     return rc;
                 continue;

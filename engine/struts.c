@@ -786,7 +786,7 @@ bool tk_strut_finder_near_covers(const tk_strut_finder *f, const tk_curve *c, co
 /* Whether the last near pairs hold every pair of t (the finder's rule
  * and tau) closer than `bound`: t's vertices are near enough theirs, and
  * its arc rule's turns changed too little to admit a pair they left out.
- * Fills the arc rule's sums for t. */
+ * The arc rule's sums must be t's (fill_prefix). */
 static bool near_holds(tk_strut_finder *f, const tk_curve *t, double bound)
 {
     if (!(f->near_reach > 0.0) || check_counts(f, t, NULL) != TK_OK)
@@ -801,7 +801,6 @@ static bool near_holds(tk_strut_finder *f, const tk_curve *t, double bound)
         if (tk_dot3(d, d) > room * room)
             return false;
     }
-    fill_prefix(f, t, f->near_rule, f->near_tau);
     /* a forward turn (and the rest of a closed component's) changed by at
      * most twice the range of the sums' change */
     for (size_t k = 0; k < t->ncomp; k++) {
@@ -821,7 +820,10 @@ static bool near_holds(tk_strut_finder *f, const tk_curve *t, double bound)
 bool tk_strut_finder_closest_near(tk_strut_finder *f, const tk_curve *t, double below,
                                   double *dist)
 {
-    if (!(below <= f->near_tau) || !near_holds(f, t, below))
+    if (!(below <= f->near_tau) || !(f->near_reach > 0.0) || check_counts(f, t, NULL) != TK_OK)
+        return false;
+    fill_prefix(f, t, f->near_rule, f->near_tau);
+    if (!near_holds(f, t, below))
         return false;
     /* as tk_strut_finder_closest_pair: the least distance below `below`
      * among the pairs the arc rule allows at t */
@@ -839,7 +841,8 @@ bool tk_strut_finder_closest_near(tk_strut_finder *f, const tk_curve *t, double 
     return true;
 }
 
-/* find_pairs from the near pairs, when they hold every pair it needs:
+/* find_pairs from the near pairs (the arc rule's sums c's, as
+ * begin_query left them), when they hold every pair it needs:
  * each goes through test_pair as the tree's would, and the tree prunes
  * only pairs farther than the bound, so the list is the same.  False
  * (nothing appended) when they do not. */
