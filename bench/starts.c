@@ -202,9 +202,16 @@ static void run_start(bench *b, const start *s)
             snprintf(excess, sizeof excess, "%+.3f%%", 100.0 * (last->ropelength / best - 1.0));
         describe(w5, sizeof w5, within[0]);
         describe(w1, sizeof w1, within[1]);
-        snprintf(line, sizeof line, "%-9s %-7s %8zu %8ld %11.5f %10s %9s %9s %5zu %5zu  %s%s%s\n",
-                 s->name, s->type, last->vertices, last->step, last->ropelength, excess, w5, w1,
-                 ne, improved, tk_stop_reason_name(why), rc ? ": " : "", rc ? err.message : "");
+        tk_run_timing t;
+        tk_run_timing_get(run, &t);
+        char rescaled[48] = "0";
+        if (t.rescales > 0)
+            snprintf(rescaled, sizeof rescaled, "%ld<%.1e", t.rescales, t.largest_rescale);
+        snprintf(line, sizeof line,
+                 "%-9s %-7s %8zu %8ld %11.5f %10s %9s %9s %5zu %5zu %6ld %11s  %s%s%s\n", s->name,
+                 s->type, last->vertices, last->step, last->ropelength, excess, w5, w1, ne,
+                 improved, t.undone_steps, rescaled, tk_stop_reason_name(why), rc ? ": " : "",
+                 rc ? err.message : "");
     }
     pthread_mutex_lock(&b->lock);
     fputs(line, stdout);
@@ -240,7 +247,9 @@ int main(int argc, char **argv)
                    "Tightens each start (default: all; --list names them) at resolution R\n"
                    "(default 5) for S seconds (default 120), N at a time (default 2), and\n"
                    "prints its final ropelength, its excess over the best known value and\n"
-                   "when it came within 0.5%% and 0.1%% of it on its final polygon.\n"
+                   "when it came within 0.5%% and 0.1%% of it on its final polygon, with\n"
+                   "the steps error recovery undid and its rescales of the whole curve\n"
+                   "(count<largest factor - 1).\n"
                    "--atlas: each at the atlas's vertex count of its type instead, for S\n"
                    "seconds (default 600), against the atlas's value.\n");
             return 0;
@@ -286,9 +295,9 @@ int main(int argc, char **argv)
         printf("starts at resolution %g, %.0f s each, %ld at a time; excess over the best known "
                "value; within: first time on the final polygon\n\n",
                b.resolution, b.seconds, jobs);
-    printf("%-9s %-7s %8s %8s %11s %10s %9s %9s %5s %5s  %s\n", "start", "type", "vertices",
-           "steps", "ropelength", "excess", b.atlas ? "within.1%" : "within.5%",
-           b.atlas ? "at.atlas" : "within.1%", "esc", "impr", "stop");
+    printf("%-9s %-7s %8s %8s %11s %10s %9s %9s %5s %5s %6s %11s  %s\n", "start", "type",
+           "vertices", "steps", "ropelength", "excess", b.atlas ? "within.1%" : "within.5%",
+           b.atlas ? "at.atlas" : "within.1%", "esc", "impr", "undone", "rescaled", "stop");
     pthread_t th[64];
     for (long k = 0; k < jobs; k++)
         pthread_create(&th[k], NULL, worker, &b);
