@@ -278,16 +278,17 @@ int tk_recovery_near(tk_run *r, const double *motion, double h, double fastest, 
  * correction tolerance (section 4.6), with at most `most` Newton steps
  * (TK_CORRECTIONS after a step); the finder is then fitted to it.  What
  * the Newton steps leave is removed by rescaling the curve about its
- * centroid when it is at most rescale_up_to (a fraction of the bound);
+ * centroid when the factor that takes is at most 1 + rescale_up_to;
  * otherwise the call fails with TK_ENUMERIC, the curve as the Newton steps
  * left it. */
 #define TK_CORRECTIONS 25
 int tk_recovery_correct(tk_run *r, int most, double rescale_up_to, int *iterations,
                         tk_error *err);
 /* Rescaling the whole curve throws away its contacts (and at a violation
- * of a few percent, the work of minutes): after a step it only removes a
- * leftover this small, a feasibility fix; a step that needs more is undone
- * and taken again shorter.  A start may need more (its own slack). */
+ * of a few percent, the work of minutes): after a step it is only a
+ * feasibility fix, by a factor of at most 1 + 1e-6; a step that needs
+ * more is undone and taken again shorter, and one that cannot be taken
+ * shorter either moves nothing.  A start may need more (its own slack). */
 #define TK_RESCALE_FEASIBILITY 1e-6
 #define TK_RESCALE_START(r) (10.0 * (r)->opt.overstep_tolerance)
 /* Scales the curve about its centroid to undo a violation `worst`. */

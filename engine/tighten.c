@@ -386,11 +386,10 @@ static int step(tk_run *r, tk_error *err)
         double worst = 0.0;
         if (!rc)
             rc = tk_recovery_violation(r, c, &worst, err);
-        /* the last attempt may rescale as the start may */
-        double up_to = attempt < STEP_ATTEMPTS - 1 ? TK_RESCALE_FEASIBILITY : TK_RESCALE_START(r);
         if (!rc && worst > 0.5 * tk_tolerance_overstep(r))
-            rc = tk_recovery_correct(r, TK_CORRECTIONS, up_to, &rep.corrections, err);
-        if (rc != TK_ENUMERIC || attempt == STEP_ATTEMPTS - 1 || !(rep.step_size > 0.0))
+            rc = tk_recovery_correct(r, TK_CORRECTIONS, TK_RESCALE_FEASIBILITY,
+                                     &rep.corrections, err);
+        if (rc != TK_ENUMERIC || !(rep.step_size > 0.0))
             break;
         /* Newton steps could not restore the thickness: undo the step,
          * take one a quarter as long (section 4.5's control doubles the
@@ -399,6 +398,16 @@ static int step(tk_run *r, tk_error *err)
         r->stepping.step_size = 0.25 * rep.step_size;
         r->recovery.undone++;
         rep.corrections = 0;
+        if (attempt == STEP_ATTEMPTS - 1) {
+            /* no shorter step could be restored either: this step moves
+             * nothing (the curve as it was, feasible), and the next one
+             * starts shorter still; a run of such steps is a stall */
+            tk_strut_finder_refit(r->shared.finder, c);
+            rep.step_size = 0.0;
+            r->stepping.tiny_steps++;
+            rc = TK_OK;
+            break;
+        }
     }
     if (!rc)
         rc = figures(r, &rep, err);

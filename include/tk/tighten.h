@@ -19,9 +19,12 @@
  *      overstep tolerance (section 4.5);
  *   5. error recovery: while some constraint is violated beyond the
  *      correction tolerance, Newton steps with the damped minimum-norm
- *      solution of A^T du = -R (section 4.6); a step they cannot restore is
- *      undone and taken shorter, and rescaling the curve is left for a
- *      leftover of 1e-6 (a resampled polygon is restored the same way).
+ *      solution of A^T du = -R (section 4.6), damped as much as they need;
+ *      a step they cannot restore is undone and taken shorter (and not
+ *      taken at all when no shorter one can be restored either), and after
+ *      a step the curve is rescaled by a factor of at most 1 + 1e-6; a
+ *      resampled polygon gets 400 Newton steps, and what they leave is
+ *      rescaled as at a start.
  * The flow keeps the tube embedded, so it cannot change the knot or link
  * type; resampling and recovery move the curve in ways its constraints
  * do not cover, so the type (tk/invariants.h) of the start is compared
