@@ -25,7 +25,7 @@
  * diameter to undo violations of 1.7e-3, and was cut to 1/256 of itself
  * every time, the worst violation falling by 0.1% a step (1.8e-3 to
  * 1.36e-3 in 236 steps at a refinement); after a step, at a run of kinks,
- * it fell by 0.85 a step and 25 corrections were often not enough (736
+ * it fell by 0.85 a step and 25 corrections were often not enough (735
  * steps undone in 60 s).  With the damping raised where steps are cut
  * short: 7.5e-4 after 12 steps at that refinement, and no step undone in
  * 60 s. */
@@ -125,7 +125,8 @@ static double rescale_factor(double worst)
     return (1.0 + RESCALE_AIM) / (1.0 - worst);
 }
 
-/* The finder is then fitted to the curve. */
+/* Scales the curve about its centroid by rescale_factor(worst); the
+ * finder is then fitted to it. */
 void tk_recovery_rescale(tk_run *r, double worst)
 {
     tk_curve *c = r->shared.curve;

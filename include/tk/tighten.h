@@ -23,8 +23,8 @@
  *      a step they cannot restore is undone and taken shorter (and not
  *      taken at all when no shorter one can be restored either), and after
  *      a step the curve is rescaled by a factor of at most 1 + 1e-6; a
- *      resampled polygon gets 400 Newton steps, and what they leave is
- *      rescaled as at a start.
+ *      resampled polygon gets 400 Newton steps, and what they leave (at
+ *      most half the diameter) is rescaled.
  * The flow keeps the tube embedded, so it cannot change the knot or link
  * type; resampling and recovery move the curve in ways its constraints
  * do not cover, so the type (tk/invariants.h) of the start is compared
