@@ -179,6 +179,47 @@ static size_t keep_violated(tk_run *r)
     return nv + nb;
 }
 
+/* One Newton step with the given damping on the violated constraints
+ * (the columns of a, their deficits in recovery.rhs): the step is halved
+ * until the worst violation falls, at most 12 times.  *improved whether
+ * it fell (the run's curve then moved, *worst its new violation),
+ * *halvings how many times the step was cut.  The finder is left fitted
+ * to the run's curve. */
+static int damped_step(tk_run *r, const cholmod_sparse *a, double damping, double *worst,
+                       int *halvings, bool *improved, tk_error *err)
+{
+    tk_curve *c = r->shared.curve, *t = r->shared.trial;
+    double *du = r->recovery.du;
+    size_t n3 = 3 * c->nvert;
+    double delta = 0.0;
+    double t0 = tk_clock();
+    int rc = tk_nnls_min_norm(r->shared.nnls, a, r->recovery.rhs, damping, du, &delta, err);
+    r->recovery.nnls_seconds += tk_clock() - t0;
+    *improved = false;
+    if (rc)
+        return rc;
+    /* Never move a vertex by more than a tenth of the diameter. */
+    double longest = 0.0;
+    for (size_t v = 0; v < c->nvert; v++)
+        longest = fmax(longest, tk_norm(du + 3 * v, 3));
+    double alpha = longest > 0.1 * r->tau ? 0.1 * r->tau / longest : 1.0;
+    for (*halvings = 0; *halvings < 12 && !rc; ++*halvings, alpha *= 0.5) {
+        for (size_t i = 0; i < n3; i++)
+            t->xyz[i] = c->xyz[i] + alpha * du[i];
+        tk_strut_finder_refit(r->shared.finder, t);
+        double trial_worst;
+        rc = tk_recovery_violation(r, t, &trial_worst, err);
+        if (!rc && trial_worst < *worst) {
+            memcpy(c->xyz, t->xyz, n3 * sizeof *c->xyz);
+            *worst = trial_worst;
+            *improved = true;
+            break;
+        }
+    }
+    tk_strut_finder_refit(r->shared.finder, c);
+    return rc;
+}
+
 /* Newton steps du solving A_V^T du = -R with minimum norm (damped), R the
  * violations of the violated constraints V among the active ones, until
  * every violation is below the correction tolerance.  Each step is damped
@@ -198,11 +239,9 @@ int tk_recovery_correct(tk_run *r, int most, double rescale_up_to, int *iteratio
 
 static int correct(tk_run *r, int most, double rescale_up_to, int *iterations, tk_error *err)
 {
-    tk_curve *c = r->shared.curve, *t = r->shared.trial;
+    tk_curve *c = r->shared.curve;
     tk_strut_finder *finder = r->shared.finder;
     tk_constraints *set = &r->recovery.violated;
-    double *du = r->recovery.du;
-    size_t n3 = 3 * c->nvert;
     *iterations = 0;
     tk_strut_finder_refit(finder, c);
     double worst, damping = RECOVERY_DAMPING;
@@ -220,49 +259,28 @@ static int correct(tk_run *r, int most, double rescale_up_to, int *iterations, t
         rc = tk_active_matrix(r, c, set, &a, err);
         if (rc)
             return rc;
-        double delta = 0.0;
-        double t0 = tk_clock();
-        rc = tk_nnls_min_norm(r->shared.nnls, a, r->recovery.rhs, damping, du, &delta,
-                              err);
-        r->recovery.nnls_seconds += tk_clock() - t0;
+        bool improved = false;
+        int halvings = 0;
+        for (;;) {
+            rc = damped_step(r, a, damping, &worst, &halvings, &improved, err);
+            if (rc || improved || !(damping < RECOVERY_DAMPING_MOST))
+                break;
+            /* no cut of the step helps: solved again, damped more */
+            damping = fmin(damping * RECOVERY_DAMPING_STEP * RECOVERY_DAMPING_STEP,
+                           RECOVERY_DAMPING_MOST);
+        }
         cholmod_free_sparse(&a, tk_nnls_common(r->shared.nnls));
         if (rc)
             return rc;
-        /* Never move a vertex by more than a tenth of the diameter. */
-        double longest = 0.0;
-        for (size_t v = 0; v < c->nvert; v++)
-            longest = fmax(longest, tk_norm(du + 3 * v, 3));
-        double alpha = longest > 0.1 * r->tau ? 0.1 * r->tau / longest : 1.0;
-        bool improved = false;
-        int halving = 0;
-        for (; halving < 12 && !improved; halving++, alpha *= 0.5) {
-            for (size_t i = 0; i < n3; i++)
-                t->xyz[i] = c->xyz[i] + alpha * du[i];
-            tk_strut_finder_refit(finder, t);
-            double trial_worst;
-            rc = tk_recovery_violation(r, t, &trial_worst, err);
-            if (rc)
-                return rc;
-            if (trial_worst < worst) {
-                memcpy(c->xyz, t->xyz, n3 * sizeof *c->xyz);
-                worst = trial_worst;
-                improved = true;
-            }
-        }
-        tk_strut_finder_refit(finder, c);
         (*iterations)++;
-        /* Levenberg-Marquardt: a step taken whole lowers the damping, one
-         * cut short raises it, one that fails raises it more and is
-         * solved again */
-        if (improved && halving <= 1)
-            damping = fmax(damping / RECOVERY_DAMPING_STEP, RECOVERY_DAMPING);
-        else if (improved && halving > RECOVERY_HALVINGS_KEPT)
-            damping = fmin(damping * RECOVERY_DAMPING_STEP, RECOVERY_DAMPING_MOST);
-        else if (!improved && damping < RECOVERY_DAMPING_MOST)
-            damping = fmin(damping * RECOVERY_DAMPING_STEP * RECOVERY_DAMPING_STEP,
-                           RECOVERY_DAMPING_MOST);
-        else if (!improved)
+        if (!improved)
             break;
+        /* Levenberg-Marquardt: a step taken whole lowers the damping, one
+         * cut short raises it */
+        if (halvings == 0)
+            damping = fmax(damping / RECOVERY_DAMPING_STEP, RECOVERY_DAMPING);
+        else if (halvings >= RECOVERY_HALVINGS_KEPT)
+            damping = fmin(damping * RECOVERY_DAMPING_STEP, RECOVERY_DAMPING_MOST);
     }
     if (rc || worst <= tk_tolerance_correction(r))
         return rc;
