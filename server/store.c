@@ -20,6 +20,7 @@
 #include <string.h>
 #include <sys/random.h>
 #include <sys/statvfs.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <libpq-fe.h>
@@ -28,6 +29,13 @@
 #include "jsonmap.h"
 
 #define IDLE_MAX 32 /* connections kept for reuse; more are opened while needed */
+/* On a shared store the documents last read are served again for a
+ * moment: a daemon that runs nothing answers a crowd of pollers of a job
+ * running elsewhere from memory, not with a query each (the job's own
+ * daemon writes it only every 2 s anyway).  Any write through this store
+ * drops them all, so a client sees its own DELETE at once. */
+#define RECENT_MAX 64   /* documents kept, one slot per id modulo this */
+#define RECENT_AGE 0.5  /* seconds a kept document is served again */
 #define MAX_PARAMS 10
 /* the advisory lock that makes a submission's limits and insert one step
  * across daemons (any number no other program on the database uses) */
@@ -43,6 +51,13 @@ struct tk_store {
     size_t nidle;
     char write_error[TK_ERROR_MESSAGE_SIZE]; /* the last write's failure, "" once one succeeds */
     char damage[TK_ERROR_MESSAGE_SIZE];      /* the first damage a reader found */
+    uint64_t writes; /* writes through this store so far */
+    struct kept {
+        int64_t id;
+        uint64_t writes; /* the count when it was read: stale once another write came */
+        double at;       /* when it was read (monotonic seconds) */
+        json_t *doc;     /* never handed out: copies are */
+    } recent[RECENT_MAX];
 };
 
 /* ---- the SQL: [0] SQLite's, [1] PostgreSQL's ---- */
@@ -431,11 +446,11 @@ static void give(tk_store *s, void *c)
  * about the job (busy, not found, not queued) are neither.  Returns rc. */
 static int written(tk_store *s, int rc, const tk_error *err)
 {
-    if (rc == TK_OK || rc == TK_EIO || rc == TK_ENOMEM) {
-        pthread_mutex_lock(&s->lock);
+    pthread_mutex_lock(&s->lock);
+    s->writes++;
+    if (rc == TK_OK || rc == TK_EIO || rc == TK_ENOMEM)
         snprintf(s->write_error, sizeof s->write_error, "%s", rc ? err->message : "");
-        pthread_mutex_unlock(&s->lock);
-    }
+    pthread_mutex_unlock(&s->lock);
     return rc;
 }
 
@@ -505,6 +520,8 @@ void tk_store_close(tk_store **p)
         return;
     while (s->nidle)
         disconnect(s, s->idle[--s->nidle]);
+    for (size_t i = 0; i < RECENT_MAX; i++)
+        json_decref(s->recent[i].doc);
     pthread_mutex_destroy(&s->lock);
     free(s->where);
     free(s);
@@ -636,9 +653,38 @@ static int ask(tk_store *s, rows *r, const char *what, tk_error *err, const char
     return rc;
 }
 
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Job id's document as read at `at`, when no write came since
+ * (`writes`), is kept to be served for RECENT_AGE; with doc NULL, a copy
+ * of the one kept, if it is still fresh, or NULL. */
+static json_t *recent(tk_store *s, int64_t id, uint64_t writes, double at, const json_t *doc)
+{
+    json_t *copy = NULL;
+    pthread_mutex_lock(&s->lock);
+    struct kept *k = &s->recent[(uint64_t)id % RECENT_MAX];
+    if (doc && writes == s->writes) {
+        json_decref(k->doc);
+        k->id = id, k->writes = writes, k->at = at, k->doc = json_deep_copy(doc);
+    } else if (!doc && k->doc && k->id == id && k->writes == s->writes && at - k->at < RECENT_AGE)
+        copy = json_deep_copy(k->doc);
+    pthread_mutex_unlock(&s->lock);
+    return copy;
+}
+
 int tk_store_get(tk_store *s, int64_t id, json_t **doc, tk_error *err)
 {
-    *doc = NULL;
+    double at = now();
+    if (s->pg && (*doc = recent(s, id, 0, at, NULL)))
+        return TK_OK;
+    pthread_mutex_lock(&s->lock);
+    uint64_t writes = s->writes;
+    pthread_mutex_unlock(&s->lock);
     rows r;
     int rc = ask(s, &r, "reading a job", err, "SELECT doc, id, state FROM jobs WHERE id = $1",
                  "i", id);
@@ -647,6 +693,8 @@ int tk_store_get(tk_store *s, int64_t id, json_t **doc, tk_error *err)
              : (*doc = row_doc(s, &r, 0, err)) ? TK_OK
                                                 : TK_EIO;
     rows_free(&r);
+    if (!rc && s->pg)
+        recent(s, id, writes, at, *doc);
     return rc;
 }
 

@@ -75,7 +75,9 @@ int tk_store_add(tk_store *s, json_t *doc, const char *input, const tk_store_lim
 int tk_store_put(tk_store *s, const json_t *doc, const char *const *parts,
                  const tk_frame *frames, size_t first, size_t nframes, tk_error *err);
 
-/* The job's document (TK_ENOTFOUND when there is none). */
+/* The job's document (TK_ENOTFOUND when there is none).  On a shared
+ * store it may be one read up to half a second ago, unless a write went
+ * through this store since. */
 int tk_store_get(tk_store *s, int64_t id, json_t **doc, tk_error *err);
 
 /* One part; *text NULL when it was never stored (free with free()). */

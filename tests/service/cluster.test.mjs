@@ -131,4 +131,33 @@ describe('three daemons on one PostgreSQL database', { skip }, () => {
         assert.match(daemons[runner].output(), new RegExp(`job ${job.id}: cancelled at step \\d+`));
         await stopAll(...daemons);
     });
+
+    test('a daemon shows its own change of a job at once, and another daemon\'s within seconds', async (t) => {
+        const db = pgDatabase();
+        const daemons = [];
+        t.after(() => daemons.forEach((d) => d.proc.kill('SIGKILL')));
+        for (let k = 0; k < 2; k++) daemons.push(await startDaemon({ workers: 1, db }));
+        // two jobs keep both workers busy, so the next two stay queued
+        const jobs = [];
+        for (let i = 0; i < 4; i++)
+            jobs.push(await submit(daemons[0], { catalogue: '3.1', options: { resolution: 10, time: 60 } }));
+        for (const j of jobs.slice(0, 2))
+            await waitJob(daemons[0], j.id, (x) => x.state === 'running');
+        const [a, b] = [jobs[2].id, jobs[3].id];
+        // read, changed through the same daemon, read again: the change at once
+        for (let i = 0; i < 3; i++) assert.equal((await daemons[1].get(`/v1/jobs/${a}`)).json.state, 'queued');
+        const r = await daemons[1].del(`/v1/jobs/${a}`);
+        assert.equal(r.status, 200, r.text);
+        assert.equal(r.json.state, 'cancelled');
+        assert.equal((await daemons[1].get(`/v1/jobs/${a}`)).json.state, 'cancelled');
+        // read through one daemon, changed through the other
+        for (let i = 0; i < 3; i++) assert.equal((await daemons[1].get(`/v1/jobs/${b}`)).json.state, 'queued');
+        assert.equal((await daemons[0].del(`/v1/jobs/${b}`)).status, 200);
+        const t0 = Date.now();
+        await waitJob(daemons[1], b, (x) => x.state === 'cancelled', { timeout: 3000, every: 10 });
+        t.diagnostic(`another daemon's cancel seen after ${Date.now() - t0} ms`);
+        for (const j of jobs.slice(0, 2)) await daemons[1].del(`/v1/jobs/${j.id}`);
+        for (const j of jobs.slice(0, 2)) await waitFinal(daemons[1], j.id);
+        await stopAll(...daemons);
+    });
 });
