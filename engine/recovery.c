@@ -3,6 +3,7 @@
  * a constraint set of its own, so the step's active set (with the forces
  * the step reports) is left as it was.  See run.h for the rooms of the
  * flow. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -179,25 +180,17 @@ static size_t keep_violated(tk_run *r)
     return nv + nb;
 }
 
-/* One Newton step with the given damping on the violated constraints
- * (the columns of a, their deficits in recovery.rhs): the step is halved
- * until the worst violation falls, at most 12 times.  *improved whether
- * it fell (the run's curve then moved, *worst its new violation),
- * *halvings how many times the step was cut.  The finder is left fitted
- * to the run's curve. */
-static int damped_step(tk_run *r, const cholmod_sparse *a, double damping, double *worst,
-                       int *halvings, bool *improved, tk_error *err)
+/* The step recovery.du from the run's curve, halved until the worst
+ * violation falls, at most 12 times.  *improved whether it fell (the
+ * run's curve then moved, *worst its new violation), *halvings how many
+ * times the step was cut.  The finder is left fitted to the run's curve. */
+static int line_search(tk_run *r, double *worst, int *halvings, bool *improved, tk_error *err)
 {
     tk_curve *c = r->shared.curve, *t = r->shared.trial;
-    double *du = r->recovery.du;
+    const double *du = r->recovery.du;
     size_t n3 = 3 * c->nvert;
-    double delta = 0.0;
-    double t0 = tk_clock();
-    int rc = tk_nnls_min_norm(r->shared.nnls, a, r->recovery.rhs, damping, du, &delta, err);
-    r->recovery.nnls_seconds += tk_clock() - t0;
+    int rc = TK_OK;
     *improved = false;
-    if (rc)
-        return rc;
     /* Never move a vertex by more than a tenth of the diameter. */
     double longest = 0.0;
     for (size_t v = 0; v < c->nvert; v++)
@@ -217,6 +210,110 @@ static int damped_step(tk_run *r, const cholmod_sparse *a, double damping, doubl
         }
     }
     tk_strut_finder_refit(r->shared.finder, c);
+    return rc;
+}
+
+/* One Newton step with the given damping on the violated constraints
+ * (the columns of a, their deficits in recovery.rhs), through
+ * line_search. */
+static int damped_step(tk_run *r, const cholmod_sparse *a, double damping, double *worst,
+                       int *halvings, bool *improved, tk_error *err)
+{
+    double delta = 0.0;
+    double t0 = tk_clock();
+    *improved = false;
+    int rc = tk_nnls_min_norm(r->shared.nnls, a, r->recovery.rhs, damping, r->recovery.du, &delta,
+                              err);
+    r->recovery.nnls_seconds += tk_clock() - t0;
+    return rc ? rc : line_search(r, worst, halvings, improved, err);
+}
+
+/* Where the violated constraints contradict each other as equations (at
+ * catalogue 5.1's refinement to 270 vertices one's linearised change had
+ * the wrong sign, down to -6.8 times its deficit, whatever the damping),
+ * the least-distance problem with inequalities still has an answer:
+ * scaling the curve up lengthens every strut and radius, so
+ *     minimise |du|  subject to  A^T du >= d
+ * over all the active constraints (d_j the deficit, negative for one with
+ * slack to give) is feasible, and over-satisfying a constraint is allowed
+ * where the equations had to split the difference.  Its dual is the
+ * non-negative quadratic problem
+ *     minimise 1/2 y^T (A^T A + delta D) y - d^T y,  y >= 0,  du = A y
+ * (D = diag(A^T A), delta D damping it as the Newton steps are), which is
+ * the NNLS problem min |B y - b| with B = [A; sqrt(delta D)] and
+ * b = [0; d / sqrt(delta D)]: B^T B is that matrix and B^T b = d.  At its
+ * answer A^T du >= d - delta D y, equal where y_j > 0. */
+#define INEQUALITY_DAMPING 1e-4
+#define INEQUALITY_STEPS 10
+
+/* One such step, taken where it lowers the worst violation (cut as
+ * damped_step cuts), as damped_step reports it. */
+static int inequality_step(tk_run *r, double *worst, bool *improved, tk_error *err)
+{
+    tk_curve *c = r->shared.curve;
+    tk_constraints *set = &r->recovery.violated;
+    *improved = false;
+    int rc = tk_active_find(r, c, set, err);
+    size_t n = set->struts.count + set->nkinks, m = 3 * c->nvert;
+    if (!rc)
+        rc = tk_grow_doubles(&r->recovery.rhs, &r->recovery.rhs_capacity, n, err);
+    if (rc || n == 0)
+        return rc;
+    double aim = 0.5 * tk_tolerance_correction(r);
+    for (size_t j = 0; j < set->struts.count; j++)
+        r->recovery.rhs[j] = r->tau * (1.0 + aim) - set->struts.items[j].length;
+    for (size_t k = 0; k < set->nkinks; k++)
+        r->recovery.rhs[set->struts.count + k] = r->min_radius * (1.0 + aim) - set->kinks[k].minrad;
+    cholmod_common *cc = tk_nnls_common(r->shared.nnls);
+    cholmod_sparse *a = NULL, *b = NULL;
+    double *rhs = calloc(m + n, sizeof *rhs), *y = calloc(n, sizeof *y);
+    rc = rhs && y ? tk_active_matrix(r, c, set, &a, err)
+                  : tk_error_set(err, TK_ENOMEM, "out of memory for a recovery step");
+    if (!rc && !(b = cholmod_allocate_sparse(m + n, n, a->nzmax + n, 1, 1, 0, CHOLMOD_REAL, cc)))
+        rc = tk_error_set(err, TK_ENOMEM, "out of memory for a recovery step");
+    if (!rc) {
+        const int *ap = a->p, *ai = a->i;
+        const double *ax = a->x;
+        int *bp = b->p, *bi = b->i;
+        double *bx = b->x;
+        size_t z = 0;
+        for (size_t j = 0; j < n; j++) {
+            bp[j] = (int)z;
+            double d = 0.0;
+            for (int e = ap[j]; e < ap[j + 1]; e++, z++) {
+                bi[z] = ai[e];
+                bx[z] = ax[e];
+                d += ax[e] * ax[e];
+            }
+            double root = sqrt(INEQUALITY_DAMPING * d);
+            bi[z] = (int)(m + j);
+            bx[z++] = root;
+            /* a column that is all zero (fixed vertices) cannot move: its
+             * term is left out */
+            rhs[m + j] = root > 0.0 ? r->recovery.rhs[j] / root : 0.0;
+        }
+        bp[n] = (int)z;
+        double t0 = tk_clock();
+        rc = tk_nnls_solve(r->shared.nnls, b, rhs, y, NULL, NULL, err);
+        r->recovery.nnls_seconds += tk_clock() - t0;
+        if (rc == TK_ENUMERIC) /* y is the best found: the line search judges it */
+            rc = TK_OK;
+    }
+    if (!rc) {
+        double *du = r->recovery.du;
+        memset(du, 0, m * sizeof *du);
+        const int *ap = a->p, *ai = a->i;
+        const double *ax = a->x;
+        for (size_t j = 0; j < n; j++)
+            for (int e = ap[j]; e < ap[j + 1]; e++)
+                du[ai[e]] += ax[e] * y[j];
+        int halvings;
+        rc = line_search(r, worst, &halvings, improved, err);
+    }
+    cholmod_free_sparse(&a, cc);
+    cholmod_free_sparse(&b, cc);
+    free(rhs);
+    free(y);
     return rc;
 }
 
@@ -281,6 +378,13 @@ static int correct(tk_run *r, int most, double rescale_up_to, int *iterations, t
             damping = fmax(damping / RECOVERY_DAMPING_STEP, RECOVERY_DAMPING);
         else if (halvings >= RECOVERY_HALVINGS_KEPT)
             damping = fmin(damping * RECOVERY_DAMPING_STEP, RECOVERY_DAMPING_MOST);
+    }
+    for (int it = 0; !rc && worst > tk_tolerance_correction(r) && it < INEQUALITY_STEPS; it++) {
+        bool improved = false;
+        rc = inequality_step(r, &worst, &improved, err);
+        (*iterations)++;
+        if (!improved)
+            break;
     }
     if (rc || worst <= tk_tolerance_correction(r))
         return rc;
