@@ -13,6 +13,7 @@
 #include <time.h>
 
 #include "support.h"
+#include "tk/curve.h"
 #include "tk/generate.h"
 #include "tk/thickness.h"
 #include "tk/record.h"
@@ -430,6 +431,64 @@ START_TEST(recovery_restores_thousands_of_contacts_without_rescaling)
     tk_run_timing_get(run, &t);
     ck_assert_int_eq(t.rescales, 0);
     tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
+START_TEST(a_refined_tight_polygon_is_restored_without_rescaling)
+{
+    if (quick())
+        return;
+    /* The generated figure-eight at 100 vertices, tightened until its
+     * kinks sit at the curvature bound, resampled to 200 as a refinement
+     * does: the spline cuts the tube at the kinks and between contacts.
+     * The Newton steps on the violated constraints stall there (as
+     * equations they contradict each other: one's repair undoes
+     * another's) and the curve used to be scaled up by 1 + 3.4e-3,
+     * losing every contact; the steps of the least-distance problem with
+     * inequalities must restore it in place. */
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_figure_eight(100, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.escapes = 0;
+    o.coarse_to_fine = false;
+    o.max_steps = 2500;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    const tk_step_report *last = run_watched(run, &o, "figure-eight at 100 vertices", NULL);
+    ck_assert_uint_ge(last->kinks, 3);
+    double coarse = last->ropelength;
+    tk_curve *fine = NULL;
+    ck_assert_int_eq(tk_curve_resample_total(tk_run_curve(run), 200, &fine, &err), TK_OK);
+    tk_run_free(&run);
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(fine, NULL, &m, NULL), TK_OK);
+    printf("resampled to 200: thickness %.6f, minrad %.6f\n", m.thickness, m.minrad);
+    ck_assert(m.thickness < 0.995);
+    /* a start may overstep this far: its recovery is what is tested */
+    tk_options p = TK_OPTIONS_INIT;
+    p.overstep_tolerance = 0.09;
+    p.max_steps = 1;
+    ck_assert_msg(tk_run_new(fine, &p, &run, &err) == TK_OK, "%s", err.message);
+    tk_run_timing t;
+    tk_run_timing_get(run, &t);
+    ck_assert_int_eq(t.rescales, 0);
+    ck_assert_int_eq(tk_thickness_measure(tk_run_curve(run), NULL, &m, NULL), TK_OK);
+    /* within the correction tolerance (3e-5) of the diameter and bound */
+    ck_assert_msg(m.thickness >= 1.0 - 3e-5, "thickness %.9f", m.thickness);
+    ck_assert_msg(m.minrad >= 0.5 * (1.0 - 3e-5), "minrad %.9f", m.minrad);
+    /* in place: the recovery lengthens the fine polygon (the spline
+     * through the coarse one is 0.17% longer than it; the flow takes that
+     * off later) by far less than the scaling did (0.34%) */
+    double before = 2.0 * tk_curve_length(fine);
+    double rope = 2.0 * tk_curve_length(tk_run_curve(run)) / m.thickness;
+    printf("restored in %d corrections: ropelength %.6f from %.6f (coarse %.6f)\n",
+           tk_run_latest(run)->corrections, rope, before, coarse);
+    ck_assert_msg(fabs(rope / before - 1.0) < 1e-3, "ropelength %.6f against %.6f", rope, before);
+    tk_run_free(&run);
+    tk_curve_free(&fine);
     tk_curve_free(&c);
 }
 END_TEST
@@ -1142,6 +1201,7 @@ int main(void)
     tcase_add_test(tc, parallel_runs_equal_serial_runs);
     tcase_add_test(tc, round_hopf_start_with_continuum_of_contacts);
     tcase_add_test(tc, recovery_restores_thousands_of_contacts_without_rescaling);
+    tcase_add_test(tc, a_refined_tight_polygon_is_restored_without_rescaling);
     tcase_add_test(tc, unknot_and_unlink_are_handled);
     tcase_add_test(tc, hopf_link_tightens_towards_8_pi);
     tcase_add_test(tc, generated_hopf_link_tightens_to_8_pi);
