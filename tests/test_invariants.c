@@ -155,7 +155,7 @@ END_TEST
 START_TEST(catalogue_links)
 {
     if (!tkt_catalogue_dir()) {
-        printf("catalogue absent: catalogue linking numbers skipped\n");
+        tkt_skip("catalogue_links", "the catalogue is absent");
         return;
     }
     /* Rolfsen's table: the unlinks, the Hopf link, Solomon's link T(2,4),
@@ -232,7 +232,7 @@ END_TEST
 START_TEST(catalogue_knot_determinants)
 {
     if (!tkt_catalogue_dir()) {
-        printf("catalogue absent: catalogue determinants skipped\n");
+        tkt_skip("catalogue_knot_determinants", "the catalogue is absent");
         return;
     }
     /* Rolfsen's table */
@@ -396,7 +396,7 @@ END_TEST
 START_TEST(catalogue_alexander_polynomials)
 {
     if (!tkt_catalogue_dir()) {
-        printf("catalogue absent: catalogue Alexander polynomials skipped\n");
+        tkt_skip("catalogue_alexander_polynomials", "the catalogue is absent");
         return;
     }
     /* Rolfsen's table, normalised to Delta(1) = 1 */

@@ -63,7 +63,7 @@ START_TEST(tree_matches_brute_force_on_catalogue)
     size_t n;
     char **names = tkt_catalogue_names(&n);
     if (!names) {
-        printf("catalogue absent: tree_matches_brute_force_on_catalogue skipped\n");
+        tkt_skip("tree_matches_brute_force_on_catalogue", "the catalogue is absent");
         return;
     }
     size_t struts = 0;
@@ -80,10 +80,6 @@ END_TEST
 
 static void resampled_case(const char *name, size_t vertices)
 {
-    if (!tkt_catalogue_dir()) {
-        printf("catalogue absent: resampled %s skipped\n", name);
-        return;
-    }
     tk_curve *c = tkt_catalogue_curve(name), *big = NULL;
     tk_error err;
     ck_assert_int_eq(tk_curve_resample_total(c, vertices, &big, &err), TK_OK);
@@ -96,6 +92,8 @@ static void resampled_case(const char *name, size_t vertices)
 
 START_TEST(tree_matches_brute_force_at_1000_vertices)
 {
+    if (!tkt_catalogue_dir() && tkt_skip("tree_matches_brute_force_at_1000_vertices", "the catalogue is absent"))
+        return;
     resampled_case("3.1.vect", 1000);
     resampled_case("6.3.2.vect", 1500);
 }
@@ -103,6 +101,8 @@ END_TEST
 
 START_TEST(tree_matches_brute_force_at_10000_vertices)
 {
+    if (!tkt_catalogue_dir() && tkt_skip("tree_matches_brute_force_at_10000_vertices", "the catalogue is absent"))
+        return;
     resampled_case("8.18.vect", 4000);
     resampled_case("10.1.vect", 10000);
 }

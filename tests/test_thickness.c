@@ -140,7 +140,7 @@ START_TEST(ropelength_invariant_under_rigid_motions_and_scaling)
     const char *names[] = {"3.1.vect", "5.2.vect", "6.3.2.vect", "3_1_328.vect",
                            "10_154_test.vect", "simple_clasp.vect"};
     if (!tkt_catalogue_dir()) {
-        printf("catalogue absent: invariance test skipped\n");
+        tkt_skip("invariance on catalogue files", "the catalogue is absent");
         return;
     }
     tkt_rng rng = {2024};
@@ -175,7 +175,7 @@ END_TEST
 START_TEST(published_values)
 {
     if (!tkt_catalogue_dir()) {
-        printf("catalogue absent: published values skipped\n");
+        tkt_skip("published_values", "the catalogue is absent");
         return;
     }
     struct {
@@ -201,7 +201,7 @@ START_TEST(doubly_critical_matters)
      * non-adjacent edge pairs, without the local-minimum test, is far
      * smaller and would make the ropelength absurd. */
     if (!tkt_catalogue_dir()) {
-        printf("catalogue absent: doubly critical test skipped\n");
+        tkt_skip("doubly critical pairs", "the catalogue is absent");
         return;
     }
     tk_curve *c = tkt_catalogue_curve("10_154_test.vect");
@@ -242,7 +242,7 @@ END_TEST
 START_TEST(contacts_of_tight_trefoil)
 {
     if (!tkt_catalogue_dir()) {
-        printf("catalogue absent: contacts test skipped\n");
+        tkt_skip("contacts_of_tight_trefoil", "the catalogue is absent");
         return;
     }
     tk_curve *c = tkt_catalogue_curve("3_1_328.vect");

@@ -19,6 +19,9 @@
 #include "tk/record.h"
 #include "tk/tighten.h"
 
+/* why a test skips in the quick form */
+#define LONG_RUN "a long run: the build without sanitizers runs it"
+
 static bool quick(void)
 {
     const char *q = getenv("TK_QUICK");
@@ -87,7 +90,7 @@ static double tighten(const tk_curve *c, tk_options *o, const char *what, tk_sto
 
 START_TEST(generated_hopf_link_tightens_to_8_pi)
 {
-    if (quick())
+    if (quick() && tkt_skip("generated_hopf_link_tightens_to_8_pi", LONG_RUN))
         return;
     /* The generated Hopf link is the tight one drawn with round polygons;
      * resampled to resolution 8 (about 200 vertices) the flow settles it
@@ -109,7 +112,7 @@ END_TEST
 
 START_TEST(hopf_link_tightens_towards_8_pi)
 {
-    if (quick())
+    if (quick() && tkt_skip("hopf_link_tightens_towards_8_pi", LONG_RUN))
         return;
     /* A Hopf link whose second circle is pulled off centre and stretched,
      * so the flow has real work to do. */
@@ -133,7 +136,7 @@ END_TEST
 
 START_TEST(generated_chain_of_three_tightens_to_12_pi_plus_4)
 {
-    if (quick())
+    if (quick() && tkt_skip("generated_chain_of_three_tightens_to_12_pi_plus_4", LONG_RUN))
         return;
     /* The tight chain of three: the end rings round (ropelength 4 pi
      * each), the middle one a stadium of two semicircles of diameter 2
@@ -318,7 +321,9 @@ static bool tighten_catalogue_trefoil(const char *what, bool autoscale, long ste
                                       double *rope, tk_stop_reason *why)
 {
     if (quick() || !tkt_catalogue_dir()) {
-        printf("%s skipped (%s)\n", what, quick() ? "quick" : "catalogue absent");
+        char test[96];
+        snprintf(test, sizeof test, "the catalogue's trefoil (%s)", what);
+        tkt_skip(test, quick() ? LONG_RUN : "the catalogue is absent");
         return false;
     }
     tk_curve *c = tkt_catalogue_curve("3.1.vect");
@@ -437,7 +442,7 @@ END_TEST
 
 START_TEST(a_refined_tight_polygon_is_restored_without_rescaling)
 {
-    if (quick())
+    if (quick() && tkt_skip("a_refined_tight_polygon_is_restored_without_rescaling", LONG_RUN))
         return;
     /* The generated figure-eight at 100 vertices, tightened until its
      * kinks sit at the curvature bound, resampled to 200 as a refinement

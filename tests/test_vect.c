@@ -153,7 +153,7 @@ START_TEST(test_catalogue_roundtrip)
 {
     const char *dir = tkt_catalogue_dir();
     if (!dir) {
-        printf("note: catalogue absent; test_catalogue_roundtrip skipped\n");
+        tkt_skip("test_catalogue_roundtrip", "the catalogue is absent");
         return;
     }
     size_t count = 0;
@@ -186,7 +186,7 @@ END_TEST
 START_TEST(test_catalogue_known_files)
 {
     if (!tkt_catalogue_dir()) {
-        printf("note: catalogue absent; test_catalogue_known_files skipped\n");
+        tkt_skip("test_catalogue_known_files", "the catalogue is absent");
         return;
     }
     tk_curve *c = tkt_catalogue_curve("3.1.vect");

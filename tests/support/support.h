@@ -3,6 +3,7 @@
 #ifndef TK_TEST_SUPPORT_H
 #define TK_TEST_SUPPORT_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -36,6 +37,13 @@ double tkt_reldiff(double a, double b);
 /* Distance from point x to the segment (b0, b1), by projection: an
  * independent reference for the engine's edge distances. */
 double tkt_point_segment(const double *x, const double *b0, const double *b1);
+
+/* Says on standard output that the test calling it skips its checks, as
+ * "SKIP test: why" at the start of a line, and returns true: the test
+ * then returns.  Check counts such a test as passed; the test runner
+ * counts it as skipped instead (one line, one test: call it once, at
+ * the test's top level). */
+bool tkt_skip(const char *test, const char *why);
 
 /* Runs a suite with Check's normal output (its summary line is what the
  * test runner counts); returns the process exit status. */
