@@ -81,8 +81,8 @@
       "resolution), to compare with tables at a given vertex count (0: not; not with a "     \
       "resolution)")                                                                         \
     X(autoscale, BOOL, false, 0, 1, "autoscale",                                             \
-      "first scale the start so that its thickness is just above the diameter (needed "      \
-      "when it is thinner)")                                                                 \
+      "scale the start so that its thickness is just above the diameter (needed when it "   \
+      "is thinner), and a curve that grows thicker than that back down to it")              \
     X(autoscale_margin, REAL, 1.002, 1.0, 1.5, NULL, "autoscale's thickness / diameter")     \
     X(max_steps, LONG, 0, 0, 1e8, "steps", "stop after this many steps (0: no limit)")       \
     X(max_seconds, REAL, 0.0, 0.0, 604800, "time",                                           \
