@@ -498,6 +498,58 @@ START_TEST(a_refined_tight_polygon_is_restored_without_rescaling)
 }
 END_TEST
 
+START_TEST(a_loose_curve_is_kept_at_the_tube)
+{
+    /* A long thin ellipse, autoscaled: its thickness is the curvature at
+     * the ends of its major axis, and shortening rounds those ends, so
+     * the curve grows thicker than the tube as it shrinks.  With
+     * autoscale a curve thicker than the start's margin is scaled down to
+     * it before the next step: each step's length is then at most the
+     * last one's scaled by margin * diameter / thickness (a step only
+     * shortens, its recovery lengthens by far less than 1e-4).  Free
+     * shortening would keep the length within a step's reach of the
+     * last, far above that bound once the thickness has grown. */
+    size_t n = 80;
+    bool closed = true;
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_curve_new(&c, 1, &n, &closed, NULL), TK_OK);
+    for (size_t k = 0; k < n; k++) {
+        double t = 2.0 * M_PI * (double)k / (double)n;
+        c->xyz[3 * k] = 10.0 * cos(t);
+        c->xyz[3 * k + 1] = 0.8 * sin(t);
+        c->xyz[3 * k + 2] = 0.0;
+    }
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.escapes = 0;
+    o.coarse_to_fine = false;
+    o.max_steps = 300;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    double bound = o.autoscale_margin * 2.0 * o.radius, thickest = 0.0;
+    int scaled = 0;
+    tk_step_report last = *tk_run_latest(run);
+    for (long k = 0; k < o.max_steps; k++) {
+        ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
+        const tk_step_report *s = tk_run_latest(run);
+        if (last.thickness > bound * (1.0 + 1e-3)) {
+            scaled++;
+            double most = last.length * bound / last.thickness * (1.0 + 1e-4);
+            ck_assert_msg(s->length <= most, "step %ld: length %.9g after %.9g at thickness %.6g",
+                          s->step, s->length, last.length, last.thickness);
+        }
+        thickest = fmax(thickest, s->thickness);
+        last = *s;
+    }
+    printf("loose ellipse: %d steps began thicker than the margin (thickest %.4f), "
+           "ropelength %.4f\n", scaled, thickest, last.ropelength);
+    ck_assert_int_ge(scaled, 3);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(unknot_and_unlink_are_handled)
 {
     /* A single round ring (the unknot) and two separate rings: no
@@ -1207,6 +1259,7 @@ int main(void)
     tcase_add_test(tc, round_hopf_start_with_continuum_of_contacts);
     tcase_add_test(tc, recovery_restores_thousands_of_contacts_without_rescaling);
     tcase_add_test(tc, a_refined_tight_polygon_is_restored_without_rescaling);
+    tcase_add_test(tc, a_loose_curve_is_kept_at_the_tube);
     tcase_add_test(tc, unknot_and_unlink_are_handled);
     tcase_add_test(tc, hopf_link_tightens_towards_8_pi);
     tcase_add_test(tc, generated_hopf_link_tightens_to_8_pi);
