@@ -246,8 +246,8 @@ static int damped_step(tk_run *r, const cholmod_sparse *a, double damping, doubl
 #define INEQUALITY_DAMPING 1e-4
 #define INEQUALITY_STEPS 10
 
-/* One such step, taken where it lowers the worst violation (cut as
- * damped_step cuts), as damped_step reports it. */
+/* One such step over the active set at the run's curve, through
+ * line_search (*improved and *worst as it reports them). */
 static int inequality_step(tk_run *r, double *worst, bool *improved, tk_error *err)
 {
     tk_curve *c = r->shared.curve;
@@ -321,8 +321,10 @@ static int inequality_step(tk_run *r, double *worst, bool *improved, tk_error *e
  * violations of the violated constraints V among the active ones, until
  * every violation is below the correction tolerance.  Each step is damped
  * until the worst violation falls (near-dependent constraints can make the
- * regularised solution long); rescaling about the centroid is the last
- * resort, for leftovers up to rescale_up_to only. */
+ * regularised solution long).  Where they can no longer lower it,
+ * inequality steps (inequality_step) take over, at most INEQUALITY_STEPS;
+ * rescaling about the centroid is the last resort, for leftovers up to
+ * rescale_up_to only. */
 static int correct(tk_run *r, int most, double rescale_up_to, int *iterations, tk_error *err);
 
 int tk_recovery_correct(tk_run *r, int most, double rescale_up_to, int *iterations,

@@ -442,17 +442,6 @@ int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_
     return resampled ? TK_OK : tk_type_check(r, "an escape's deformation", err);
 }
 
-/* Re-resolution during the run: the start was resampled to `resolution`
- * vertices per unit of ropelength, and as the knot tightens that count
- * grows finer than asked for.  Finer than needed costs twice: every step
- * solves for more constraints, and the step the flow can take (explicit
- * Euler on the length gradient, whose stiffness grows as the edges
- * shorten, and the overstep control at kinks) shrinks with the edges.
- * When the ropelength has fallen by the re_resolve fraction since the
- * last resampling and the count is that much too fine, the curve is
- * resampled along its spline to ceil(resolution * ropelength) vertices
- * and scaled about its centroid just enough to be feasible again (costing
- * as much length, relatively, as the resampling cost thickness). */
 /* A loose curve is kept at the tube.  Shortening a curve that touches
  * nothing can open its narrowest gap before the strands close in again,
  * so its thickness grows past the tube's and its ropelength, the measure
@@ -474,6 +463,17 @@ static void keep_at_tube(tk_run *r)
     tk_curve_scale(r->shared.curve, r->opt.autoscale_margin * r->tau / s->thickness);
 }
 
+/* Re-resolution during the run: the start was resampled to `resolution`
+ * vertices per unit of ropelength, and as the knot tightens that count
+ * grows finer than asked for.  Finer than needed costs twice: every step
+ * solves for more constraints, and the step the flow can take (explicit
+ * Euler on the length gradient, whose stiffness grows as the edges
+ * shorten, and the overstep control at kinks) shrinks with the edges.
+ * When the ropelength has fallen by the re_resolve fraction since the
+ * last resampling and the count is that much too fine, the curve is
+ * resampled along its spline to ceil(resolution * ropelength) vertices
+ * and scaled about its centroid just enough to be feasible again (costing
+ * as much length, relatively, as the resampling cost thickness). */
 int tk_schedule_before_step(tk_run *r, tk_error *err)
 {
     const tk_options *o = &r->opt;
