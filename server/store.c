@@ -680,11 +680,14 @@ static json_t *recent(tk_store *s, int64_t id, uint64_t writes, double at, const
 int tk_store_get(tk_store *s, int64_t id, json_t **doc, tk_error *err)
 {
     double at = now();
-    if (s->pg && (*doc = recent(s, id, 0, at, NULL)))
-        return TK_OK;
-    pthread_mutex_lock(&s->lock);
-    uint64_t writes = s->writes;
-    pthread_mutex_unlock(&s->lock);
+    uint64_t writes = 0;
+    if (s->pg) {
+        if ((*doc = recent(s, id, 0, at, NULL)))
+            return TK_OK;
+        pthread_mutex_lock(&s->lock);
+        writes = s->writes;
+        pthread_mutex_unlock(&s->lock);
+    }
     rows r;
     int rc = ask(s, &r, "reading a job", err, "SELECT doc, id, state FROM jobs WHERE id = $1",
                  "i", id);

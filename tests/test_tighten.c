@@ -509,15 +509,10 @@ START_TEST(a_loose_curve_is_kept_at_the_tube)
      * shortens, its recovery lengthens by far less than 1e-4).  Free
      * shortening would keep the length within a step's reach of the
      * last, far above that bound once the thickness has grown. */
-    size_t n = 80;
-    bool closed = true;
-    tk_curve *c = NULL;
-    ck_assert_int_eq(tk_curve_new(&c, 1, &n, &closed, NULL), TK_OK);
-    for (size_t k = 0; k < n; k++) {
-        double t = 2.0 * M_PI * (double)k / (double)n;
-        c->xyz[3 * k] = 10.0 * cos(t);
-        c->xyz[3 * k + 1] = 0.8 * sin(t);
-        c->xyz[3 * k + 2] = 0.0;
+    tk_curve *c = tkt_regular_polygon(80, 1.0);
+    for (size_t k = 0; k < c->nvert; k++) {
+        c->xyz[3 * k] *= 10.0;
+        c->xyz[3 * k + 1] *= 0.8;
     }
     tk_options o = TK_OPTIONS_INIT;
     o.autoscale = true;
