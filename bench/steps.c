@@ -51,12 +51,13 @@ static void row(const tk_run *run, const tk_run_timing *a, const tk_run_timing *
     const tk_strut *struts = tk_run_struts(run, &ns);
     for (size_t j = 0; j < ns; j++)
         forced += struts[j].force > 0.0;
-    printf("%8zu %7zu %6zu %6zu %9.1f %10.6f | %8.1f %8.1f %8.1f %8.1f %8.1f %8.1f | %6.1f "
-           "%6.1f\n",
+    printf("%8zu %7zu %6zu %6zu %9.1f %10.6f | %8.1f %8.1f %8.1f %8.1f %8.1f %8.1f %8.1f | "
+           "%6.1f %6.1f\n",
            last->vertices, last->struts, forced, last->kinks, ms * (b->total - a->total),
            last->ropelength, ms * (b->search - a->search), ms * (b->matrix - a->matrix),
            ms * (b->nnls - a->nnls), ms * (b->checks - a->checks),
            ms * (b->stepping - a->stepping), ms * (b->recovery - a->recovery),
+           ms * (b->figures - a->figures),
            (double)(b->nnls_iterations - a->nnls_iterations) / n,
            (double)(b->factorisations - a->factorisations) / n);
     fflush(stdout);
@@ -64,9 +65,9 @@ static void row(const tk_run *run, const tk_run_timing *a, const tk_run_timing *
 
 static void header(void)
 {
-    printf("\n%8s %7s %6s %6s %9s %10s | %8s %8s %8s %8s %8s %8s | %6s %6s\n", "vertices",
-           "struts", "forced", "kinks", "ms/step", "ropelength", "search", "matrix", "nnls",
-           "checks", "stepping", "recovery", "iter", "facts");
+    printf("\n%8s %7s %6s %6s %9s %10s | %8s %8s %8s %8s %8s %8s %8s | %6s %6s\n",
+           "vertices", "struts", "forced", "kinks", "ms/step", "ropelength", "search", "matrix",
+           "nnls", "checks", "stepping", "recovery", "figures", "iter", "facts");
 }
 
 static void footer(void)

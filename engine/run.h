@@ -162,6 +162,7 @@ struct tk_run {
         tk_progress_fn progress;
         void *user;
         double seconds;  /* spent in tk_run_new and tk_run_step */
+        double figures_seconds; /* a step's figures measured and recorded */
     } life;
 
     struct {             /* tighten.c: the knot or link type */

@@ -263,37 +263,37 @@ void tk_strut_finder_refit(tk_strut_finder *f, const tk_curve *c)
     }
 }
 
+/* The arc rule's weight of vertex i of component k: its turn (Fenchel), or
+ * the most it can turn with 2 minrad >= tau (equation 3 solved for theta);
+ * 0 at the ends of an open component. */
+static double vertex_weight(const tk_curve *c, size_t k, size_t i, tk_arc_rule rule, double tau)
+{
+    size_t n = tk_curve_comp_vertices(c, k), base = c->offset[k];
+    if (!c->closed[k] && (i == 0 || i + 1 == n))
+        return 0.0;
+    const double *prev = c->xyz + 3 * (base + (i + n - 1) % n);
+    const double *v = c->xyz + 3 * (base + i);
+    const double *next = c->xyz + 3 * (base + (i + 1) % n);
+    if (rule == TK_ARC_FENCHEL)
+        return tk_vertex_turning(prev, v, next);
+    double la = sqrt((v[0] - prev[0]) * (v[0] - prev[0]) + (v[1] - prev[1]) * (v[1] - prev[1]) +
+                     (v[2] - prev[2]) * (v[2] - prev[2]));
+    double lb = sqrt((next[0] - v[0]) * (next[0] - v[0]) + (next[1] - v[1]) * (next[1] - v[1]) +
+                     (next[2] - v[2]) * (next[2] - v[2]));
+    return 2.0 * atan(fmin(la, lb) / tau);
+}
+
 /* Vertex weights for the arc rule, summed per component: prefix[k] is the
  * sum of the weights of the component's vertices 0 .. k-1. */
 static void fill_prefix(tk_strut_finder *f, const tk_curve *c, tk_arc_rule rule,
                         double tau)
 {
     for (size_t k = 0; k < c->ncomp; k++) {
-        size_t n = tk_curve_comp_vertices(c, k), base = c->offset[k];
+        size_t n = tk_curve_comp_vertices(c, k);
         double *p = f->prefix + f->prefix_offset[k];
         p[0] = 0.0;
-        for (size_t i = 0; i < n; i++) {
-            double w = 0.0;
-            if (c->closed[k] || (i > 0 && i + 1 < n)) {
-                const double *prev = c->xyz + 3 * (base + (i + n - 1) % n);
-                const double *v = c->xyz + 3 * (base + i);
-                const double *next = c->xyz + 3 * (base + (i + 1) % n);
-                if (rule == TK_ARC_FENCHEL) {
-                    w = tk_vertex_turning(prev, v, next);
-                } else {
-                    double la = sqrt((v[0] - prev[0]) * (v[0] - prev[0]) +
-                                     (v[1] - prev[1]) * (v[1] - prev[1]) +
-                                     (v[2] - prev[2]) * (v[2] - prev[2]));
-                    double lb = sqrt((next[0] - v[0]) * (next[0] - v[0]) +
-                                     (next[1] - v[1]) * (next[1] - v[1]) +
-                                     (next[2] - v[2]) * (next[2] - v[2]));
-                    /* The most a vertex can turn with 2 minrad >= tau
-                     * (equation 3 solved for theta). */
-                    w = 2.0 * atan(fmin(la, lb) / tau);
-                }
-            }
-            p[i + 1] = p[i] + w;
-        }
+        for (size_t i = 0; i < n; i++)
+            p[i + 1] = p[i] + vertex_weight(c, k, i, rule, tau);
     }
 }
 
@@ -672,7 +672,7 @@ int tk_strut_finder_shortest(tk_strut_finder *f, const tk_curve *c, double *shor
         return rc;
     query qy = {f, c, TK_ARC_FENCHEL, INFINITY, true, false, {{0}}, NULL, TK_OK};
     *shortest = INFINITY;
-    if (f->nedges < 2)
+    if (f->nedges < 2 || tk_strut_finder_shortest_near(f, c, shortest, where))
         return TK_OK;
     /* Branch and bound needs a good bound early: with none, every node pair
      * closer than the first contact found is opened, and on a finely
@@ -838,6 +838,58 @@ bool tk_strut_finder_closest_near(tk_strut_finder *f, const tk_curve *t, double 
             least = cl.dist;
     }
     *dist = least;
+    return true;
+}
+
+/* How far t's turns exceed what the admissible rule (with tau) allows
+ * them, summed over the vertices: 0 when 2 minrad >= tau everywhere. */
+static double turn_excess(const tk_curve *t, double tau)
+{
+    double excess = 0.0;
+    for (size_t k = 0; k < t->ncomp; k++)
+        for (size_t i = 0; i < tk_curve_comp_vertices(t, k); i++)
+            excess += fmax(vertex_weight(t, k, i, TK_ARC_FENCHEL, tau) -
+                               vertex_weight(t, k, i, TK_ARC_ADMISSIBLE, tau),
+                           0.0);
+    return excess;
+}
+
+/* Why the admissible near pairs serve the Fenchel rule: a pair the
+ * Fenchel rule allows at t turns by at least pi between its edges, so
+ * the admissible weights there add up to at least pi minus t's excess;
+ * near_holds allows their sums to have changed by a quarter of
+ * NEAR_ARC_SLACK since the list was made, and an excess of another
+ * quarter leaves the pair within the slack the list was made with.  Its
+ * distance at t below `bound` was below tau + 2 reach there. */
+bool tk_strut_finder_shortest_near(tk_strut_finder *f, const tk_curve *t, double *shortest,
+                                   tk_strut *where)
+{
+    if (!(f->near_reach > 0.0) || f->near_rule != TK_ARC_ADMISSIBLE ||
+        check_counts(f, t, NULL) != TK_OK)
+        return false;
+    double moved2 = 0.0;
+    for (size_t v = 0; v < t->nvert; v++) {
+        const double *p = t->xyz + 3 * v, *q = f->near_of + 3 * v;
+        double d[3] = {p[0] - q[0], p[1] - q[1], p[2] - q[2]};
+        moved2 = fmax(moved2, tk_dot3(d, d));
+    }
+    /* (the margin is far above the rounding of a distance) */
+    double bound = (f->near_tau + 2.0 * (f->near_reach - sqrt(moved2))) * (1.0 - 1e-9);
+    if (!(bound > 0.0))
+        return false;
+    fill_prefix(f, t, TK_ARC_ADMISSIBLE, f->near_tau);
+    if (!near_holds(f, t, bound) || !(turn_excess(t, f->near_tau) <= 0.25 * NEAR_ARC_SLACK))
+        return false;
+    /* as the tree's search in shortest mode, over the near pairs */
+    fill_prefix(f, t, TK_ARC_FENCHEL, 0.0);
+    query qy = {f, t, TK_ARC_FENCHEL, bound, true, false, {{0}}, NULL, TK_OK};
+    for (size_t k = 0; k < f->nnear; k++)
+        test_pair(&qy, f->near[2 * k], f->near[2 * k + 1]);
+    if (!(qy.bound < bound))
+        return false;
+    *shortest = qy.bound;
+    if (where)
+        *where = qy.best;
     return true;
 }
 

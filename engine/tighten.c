@@ -123,12 +123,16 @@ static int record(tk_run *r, tk_step_report *rep, tk_error *err)
  * then recorded. */
 static int figures(tk_run *r, tk_step_report *rep, tk_error *err)
 {
+    double t0 = tk_clock();
     int rc = tk_recovery_violation(r, r->shared.curve, &rep->violation, err);
     rep->struts = r->active.set.struts.count;
     if (!rc)
         rc = tk_active_report(r, err);
     rep->kinks = r->active.nreport;
-    return rc ? rc : record(r, rep, err);
+    if (!rc)
+        rc = record(r, rep, err);
+    r->life.figures_seconds += tk_clock() - t0;
+    return rc;
 }
 
 /* A run from `start` (resampled and scaled as the options ask), or, with
@@ -489,6 +493,7 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out)
         .total = r->life.seconds,
         .stepping = r->stepping.seconds,
         .recovery = r->recovery.seconds,
+        .figures = r->life.figures_seconds,
         .nnls_solves = r->motion.nnls_solves,
         .nnls_iterations = r->motion.nnls_iterations,
         .factorisations = r->motion.factorisations,

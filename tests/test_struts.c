@@ -128,8 +128,10 @@ END_TEST
  * just farther than a bound near 1: the tree's cheap pair bound
  * (struts.c, pair_beyond) must drop those and no other.  Struts and the
  * closest pair against brute force at bounds 1e-6 to 1e-2 above the
- * shortest. */
-static tk_curve *stadium(size_t n)
+ * shortest.  (`noise` scales the displacements: at 1 the polygon turns by
+ * up to about 0.03 at each vertex of the sides, beyond the 0.023 that the
+ * curvature bound of a tube of diameter 1 allows its edges.) */
+static tk_curve *stadium(size_t n, double noise)
 {
     size_t counts[1] = {n};
     bool closed[1] = {true};
@@ -149,8 +151,8 @@ static tk_curve *stadium(size_t n)
             double a = (s - 2.0 * side - cap) / 0.5;
             p[0] = -0.5 * sin(a), p[1] = 0.5 + 0.5 * cos(a);
         }
-        p[1] += 5e-5 * cos(1.7 * (double)k);
-        p[2] = 1e-4 * sin(2.39996 * (double)k);
+        p[1] += noise * 5e-5 * cos(1.7 * (double)k);
+        p[2] = noise * 1e-4 * sin(2.39996 * (double)k);
     }
     return c;
 }
@@ -158,7 +160,7 @@ static tk_curve *stadium(size_t n)
 START_TEST(tree_matches_brute_force_on_strands_side_by_side)
 {
     size_t n = 2000;
-    tk_curve *c = stadium(n);
+    tk_curve *c = stadium(n, 1.0);
     tk_strut_finder *f = NULL;
     tk_error err;
     ck_assert_int_eq(tk_strut_finder_new(c, &f, &err), TK_OK);
@@ -192,18 +194,33 @@ START_TEST(tree_matches_brute_force_on_strands_side_by_side)
 }
 END_TEST
 
+/* Smooth displacements of every vertex of c by up to `reach` (a few waves
+ * along the curve, as a step's motion), into t: trial k of 40. */
+static void displace(const tk_curve *c, tk_curve *t, double reach, int trial)
+{
+    size_t n = c->nvert;
+    double phase = 0.7 * trial, waves = 1 + trial % 5, size = reach * (0.2 + 0.02 * trial);
+    for (size_t v = 0; v < n; v++) {
+        double a = 2.0 * M_PI * waves * (double)v / (double)n;
+        double d[3] = {cos(a + phase), sin(2.0 * a - phase), cos(3.0 * a + 2.0 * phase)};
+        double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int k = 0; k < 3; k++)
+            t->xyz[3 * v + k] = c->xyz[3 * v + k] + size * d[k] / fmax(len, 1.0);
+    }
+}
+
 /* Checks near a curve (tk_strut_finder_near) give the tree's closest
  * pair, struts and pairs near contacts exactly, on the stadium above: its caps are half circles of
  * diameter 1, so pairs across them sit at the arc rule's edge (a turn of
  * pi) at distance about 1, and moving the curve changes which of them the
- * rule allows.  Smooth displacements of every vertex by up to the reach
- * (a few waves along the curve, as a step's motion), at bounds below and
- * above the closest pair; a curve farther than the reach, or one whose
- * edges all change length (rough noise), is declined. */
+ * rule allows.  Smooth displacements of every vertex by up to the reach,
+ * at bounds below and above the closest pair; a curve farther than the
+ * reach, or one whose edges all change length (rough noise), is
+ * declined. */
 START_TEST(near_checks_equal_the_tree)
 {
     size_t n = 2000;
-    tk_curve *c = stadium(n), *t = NULL;
+    tk_curve *c = stadium(n, 1.0), *t = NULL;
     tk_error err;
     ck_assert_int_eq(tk_curve_copy(c, &t, &err), TK_OK);
     tk_strut_finder *f = NULL, *plain = NULL;
@@ -214,14 +231,7 @@ START_TEST(near_checks_equal_the_tree)
     ck_assert_int_eq(tk_strut_finder_near(f, c, TK_ARC_ADMISSIBLE, 1.0, reach, &err), TK_OK);
     int compared = 0, below = 0;
     for (int trial = 0; trial < 40; trial++) {
-        double phase = 0.7 * trial, waves = 1 + trial % 5, size = reach * (0.2 + 0.02 * trial);
-        for (size_t v = 0; v < n; v++) {
-            double a = 2.0 * M_PI * waves * (double)v / (double)n;
-            double d[3] = {cos(a + phase), sin(2.0 * a - phase), cos(3.0 * a + 2.0 * phase)};
-            double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-            for (int k = 0; k < 3; k++)
-                t->xyz[3 * v + k] = c->xyz[3 * v + k] + size * d[k] / fmax(len, 1.0);
-        }
+        displace(c, t, reach, trial);
         tk_strut_finder_refit(f, t);
         tk_strut_finder_refit(plain, t);
         /* the struts and the pairs near contacts, from the near pairs
@@ -271,6 +281,66 @@ START_TEST(near_checks_equal_the_tree)
     tk_strut_finder_free(&f);
     tk_strut_finder_free(&plain);
     tk_curve_free(&t);
+    tk_curve_free(&c);
+}
+END_TEST
+
+/* The shortest doubly critical distance (Definition 1, the Fenchel arc
+ * rule) from the near pairs (made with the admissible rule, which allows
+ * every pair the Fenchel rule does on a curve that keeps the curvature
+ * bound) equals the tree's, on the stadium with a hundredth of its noise,
+ * whose vertices keep the bound, moved as in the test above; the noisy
+ * stadium, which bends beyond the bound at every vertex, and a curve bent
+ * far beyond it at one vertex are declined, as are curves farther than
+ * the reach. */
+START_TEST(shortest_near_equals_the_tree)
+{
+    size_t n = 2000;
+    double reach = 2e-3;
+    tk_curve *c = stadium(n, 0.01), *t = NULL, *noisy = stadium(n, 1.0);
+    tk_error err;
+    ck_assert_int_eq(tk_curve_copy(c, &t, &err), TK_OK);
+    tk_strut_finder *f = NULL, *plain = NULL;
+    ck_assert_int_eq(tk_strut_finder_new(c, &f, &err), TK_OK);
+    ck_assert_int_eq(tk_strut_finder_new(c, &plain, &err), TK_OK);
+    ck_assert_int_eq(tk_strut_finder_near(f, c, TK_ARC_ADMISSIBLE, 1.0, reach, &err), TK_OK);
+    int compared = 0;
+    double least = INFINITY, most = 0.0;
+    for (int trial = 0; trial < 40; trial++) {
+        displace(c, t, reach, trial);
+        tk_strut_finder_refit(plain, t);
+        double tree = 0.0, near = -1.0;
+        ck_assert_int_eq(tk_strut_finder_shortest(plain, t, &tree, NULL, &err), TK_OK);
+        if (!tk_strut_finder_shortest_near(f, t, &near, NULL))
+            continue;
+        ck_assert_msg(near == tree, "trial %d: near %.17g, tree %.17g", trial, near, tree);
+        least = fmin(least, tree);
+        most = fmax(most, tree);
+        compared++;
+    }
+    printf("shortest doubly critical distance near a curve: %d of 40 compared, %.9f to "
+           "%.9f\n",
+           compared, least, most);
+    ck_assert_int_ge(compared, 25);
+    double shortest = -1.0;
+    /* the same stadium with its full noise, made into the near curve */
+    ck_assert_int_eq(tk_strut_finder_near(plain, noisy, TK_ARC_ADMISSIBLE, 1.0, reach, &err),
+                     TK_OK);
+    ck_assert(!tk_strut_finder_shortest_near(plain, noisy, &shortest, NULL));
+    /* a kink: one vertex of a straight side moved across it by half the
+     * reach, a turn of about 0.17 where the bound allows 0.023 */
+    memcpy(t->xyz, c->xyz, 3 * n * sizeof *t->xyz);
+    t->xyz[3 * 300 + 2] += 0.5 * reach;
+    ck_assert(!tk_strut_finder_shortest_near(f, t, &shortest, NULL));
+    /* too far: one vertex beyond the reach */
+    t->xyz[3 * 300 + 2] = c->xyz[3 * 300 + 2];
+    t->xyz[3 * 500 + 2] += 1.01 * reach;
+    ck_assert(!tk_strut_finder_shortest_near(f, t, &shortest, NULL));
+    ck_assert(shortest == -1.0);
+    tk_strut_finder_free(&f);
+    tk_strut_finder_free(&plain);
+    tk_curve_free(&t);
+    tk_curve_free(&noisy);
     tk_curve_free(&c);
 }
 END_TEST
@@ -406,6 +476,7 @@ int main(void)
     tcase_add_test(tc, tree_matches_brute_force_on_generated);
     tcase_add_test(tc, tree_matches_brute_force_on_strands_side_by_side);
     tcase_add_test(tc, near_checks_equal_the_tree);
+    tcase_add_test(tc, shortest_near_equals_the_tree);
     tcase_add_test(tc, admissible_pairs_of_equilateral_polygon);
     tcase_add_test(tc, contact_at_shared_vertex_is_one_strut);
     tcase_add_test(tc, vertex_that_is_not_a_local_minimum_is_no_strut);

@@ -134,6 +134,16 @@ bool tk_strut_finder_near_covers(const tk_strut_finder *f, const tk_curve *c, co
 bool tk_strut_finder_closest_near(tk_strut_finder *f, const tk_curve *t, double below,
                                   double *dist);
 
+/* tk_strut_finder_shortest(f, t) from the pairs of the last
+ * tk_strut_finder_near (TK_ARC_ADMISSIBLE; the Fenchel rule's pairs of
+ * a curve whose turns keep the curvature bound, or nearly, are among
+ * them): the same answer.  False (*shortest untouched) when t is not
+ * near enough that curve, or bends too far beyond the bound, to tell;
+ * tk_strut_finder_shortest tries this first.  The finder need not be
+ * fitted to t. */
+bool tk_strut_finder_shortest_near(tk_strut_finder *f, const tk_curve *t, double *shortest,
+                                   tk_strut *where);
+
 /* The same answers by checking every pair of edges: O(V^2), for tests and
  * for comparison in benchmarks. */
 int tk_struts_find_brute(const tk_curve *c, tk_arc_rule rule, double tau,

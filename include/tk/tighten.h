@@ -254,6 +254,8 @@ typedef struct tk_run_timing {
     double total;        /* tk_run_new and tk_run_step, all of them */
     double stepping;     /* step control (section 4.5), everything it called */
     double recovery;     /* error recovery (section 4.6), everything it called */
+    double figures;      /* each step's figures: its worst violation, kinks,
+                            thickness and ropelength (included in total) */
     long nnls_solves, nnls_iterations, factorisations;
     double invariants;   /* the knot type computed and compared (included
                             in total) */
