@@ -124,6 +124,8 @@ struct tk_run {
         double resolved_at;  /* ropelength at the last re-resolution */
         double start_ropelength; /* of the input, before any resampling, by its
                                     self-distance (the vertex counts' reference) */
+        double final_ropelength; /* the final polygon's reference, fixed when the
+                                    run first reaches it (0: not yet) */
         int coarse_level;    /* halvings of the vertex count still to undo */
         int coarse_levels;   /* of them at the start */
         bool move_on;        /* refine before the next step */

@@ -111,6 +111,30 @@ static double reckoned_ropelength(const tk_measure *m)
                                                         : m->ropelength;
 }
 
+/* The ropelength the vertex counts of a resolution are reckoned from.  A
+ * loose start is far longer than the knot it tightens to, and a count
+ * reckoned from it is that much finer than the resolution asks for, all
+ * run long: T(2,7) generated on a round torus (ropelength 121, the tight
+ * 7_1 about 61.4) got 606 vertices at resolution 5, where catalogue 7.1
+ * got 373, and was at 64.13 after 120 s, trapped in its torus symmetry,
+ * with three escapes; catalogue 7.1 reached 61.44.  So the final polygon
+ * is reckoned from the ropelength the run has reached when it first
+ * leaves its coarse levels for it (at most the start's), and keeps that
+ * count through the escapes, whose coarse levels are reckoned from it
+ * too.  Until then, and for the coarse levels, the start's (or the
+ * current ropelength, if lower).  With re_resolve the counts follow the
+ * ropelength throughout instead. */
+static double reference_ropelength(const tk_run *r)
+{
+    if (r->opt.re_resolve > 0.0)
+        return r->life.latest.ropelength;
+    if (r->schedule.final_ropelength > 0.0)
+        return r->schedule.final_ropelength;
+    double rope = r->life.latest.ropelength;
+    return rope > 0.0 && rope < r->schedule.start_ropelength ? rope
+                                                             : r->schedule.start_ropelength;
+}
+
 /* The resolution of the final polygon: the option's, or the vertices
  * asked for per unit of the start's ropelength (0: the input's polygon). */
 static double resolution_final(const tk_run *r)
@@ -135,7 +159,11 @@ size_t tk_schedule_final_count(const tk_run *r)
         return r->shared.curve->nvert;
     if (r->opt.vertices > 0)
         return r->opt.vertices;
-    return (size_t)ceil(r->opt.resolution * r->schedule.start_ropelength);
+    /* (at most this until the final polygon is first reached) */
+    double rope = r->schedule.final_ropelength > 0.0 && !(r->opt.re_resolve > 0.0)
+                      ? r->schedule.final_ropelength
+                      : r->schedule.start_ropelength;
+    return (size_t)ceil(r->opt.resolution * rope);
 }
 
 bool tk_schedule_final(const tk_run *r)
@@ -278,6 +306,7 @@ int tk_schedule_resume(tk_run *r, const tk_curve *curve, const tk_resume *at, tk
     r->schedule.polish_level = at->polish_level;
     r->schedule.share_from = at->share_from;
     r->schedule.resolved_at = at->resolved_at > 0.0 ? at->resolved_at : INFINITY;
+    r->schedule.final_ropelength = at->final_ropelength;
     tk_measure m;
     int rc = tk_curve_copy(curve, &r->shared.curve, err);
     if (!rc)
@@ -296,6 +325,7 @@ void tk_schedule_resume_point(const tk_run *r, tk_resume *out)
     out->polish_level = r->schedule.polish_level;
     out->share_from = r->schedule.share_from;
     out->resolved_at = isfinite(r->schedule.resolved_at) ? r->schedule.resolved_at : 0.0;
+    out->final_ropelength = r->schedule.final_ropelength;
 }
 
 /* Resamples the run's curve to `count` vertices along its spline and
@@ -372,8 +402,9 @@ static int refine(tk_run *r, tk_error *err)
 {
     r->schedule.move_on = false;
     r->schedule.coarse_level--;
-    double rope =
-        r->opt.re_resolve > 0.0 ? r->life.latest.ropelength : r->schedule.start_ropelength;
+    double rope = reference_ropelength(r);
+    if (r->schedule.coarse_level == 0 && !(r->schedule.final_ropelength > 0.0))
+        r->schedule.final_ropelength = rope;
     return resample_to(r, level_count(r, rope), err);
 }
 
@@ -418,9 +449,7 @@ int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_
     size_t count = curve->nvert;
     if (coarse && r->schedule.coarse_levels > 0) {
         r->schedule.coarse_level = r->schedule.coarse_levels;
-        double rope = r->opt.re_resolve > 0.0 ? r->life.latest.ropelength
-                                              : r->schedule.start_ropelength;
-        count = level_count(r, rope);
+        count = level_count(r, reference_ropelength(r));
     }
     tk_measure m;
     int rc = measure(curve, &m, err);

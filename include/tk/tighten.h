@@ -75,7 +75,9 @@
     X(resolution, REAL, 0.0, 0.0, 1e4, "resolution",                                         \
       "resample the start to resolution x ropelength vertices (5 quick, 10 medium, 20 "      \
       "fine), its ropelength reckoned from its self-distance (2 length / shortest "          \
-      "self-distance: a noisy start's curvature does not count); 0 keeps the input's")      \
+      "self-distance: a noisy start's curvature does not count), and going coarse to fine "  \
+      "the final polygon to resolution x the ropelength reached by then; 0 keeps the "      \
+      "input's")                                                                             \
     X(vertices, SIZE, 0, 0, 1e6, "vertices",                                                 \
       "resample the start to this many vertices in all (coarse to fine as with a "          \
       "resolution), to compare with tables at a given vertex count (0: not; not with a "     \
@@ -290,6 +292,8 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out);
       "the part of the budget spent when the current schedule began")                        \
     X(resolved_at, REAL, 0, 0, 1e300, "resolved_at",                                        \
       "ropelength at the last re-resolution (0: none yet)")                                  \
+    X(final_ropelength, REAL, 0, 0, 1e300, "final_ropelength",                              \
+      "the ropelength the final polygon's vertices are reckoned from (0: not yet fixed)")    \
     X(step_size, REAL, 0, 0, 1e300, "step_size", "the last step's size")                     \
     X(escapes, INT, 0, 0, 1000, "escapes", "escapes tried")                                 \
     X(draws, LONG, 0, 0, 9e15, "draws", "numbers drawn from the escapes' random stream")    \
