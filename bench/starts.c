@@ -84,6 +84,7 @@ static const start starts[] = {
     {"10.124", "10_124", ROPE_10_124, FILE_START, "10.124", 0, 0, 0, 0, 0},
     {"T(3,5)", "10_124", ROPE_10_124, TORUS, NULL, 3, 5, 300, 0, 0},
     {"T(3,5)~", "10_124", ROPE_10_124, TORUS, NULL, 3, 5, 300, 18, 0.01},
+    {"7.1", "7_1", NAN, FILE_START, "7.1", 0, 0, 0, 0, 0},
     {"T(2,7)", "7_1", NAN, TORUS, NULL, 2, 7, 280, 0, 0},
     {"2.2.1", "Hopf", ROPE_HOPF, FILE_START, "2.2.1", 0, 0, 0, 0, 0},
     {"hopf~", "Hopf", ROPE_HOPF, HOPF, NULL, 0, 0, 60, 19, 0.01},
