@@ -857,10 +857,10 @@ static double turn_excess(const tk_curve *t, double tau)
 /* Why the admissible near pairs serve the Fenchel rule: a pair the
  * Fenchel rule allows at t turns by at least pi between its edges, so
  * the admissible weights there add up to at least pi minus t's excess;
- * near_holds allows their sums to have changed by a quarter of
- * NEAR_ARC_SLACK since the list was made, and an excess of another
- * quarter leaves the pair within the slack the list was made with.  Its
- * distance at t below `bound` was below tau + 2 reach there. */
+ * near_holds bounds their change since the list was made by half of
+ * NEAR_ARC_SLACK, and an excess of a quarter more leaves the pair within
+ * the slack the list was made with.  Its distance at t below `bound` was
+ * below tau + 2 reach there. */
 bool tk_strut_finder_shortest_near(tk_strut_finder *f, const tk_curve *t, double *shortest,
                                    tk_strut *where)
 {
