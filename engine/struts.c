@@ -783,23 +783,19 @@ bool tk_strut_finder_near_covers(const tk_strut_finder *f, const tk_curve *c, co
     return true;
 }
 
-/* Whether the last near pairs hold every pair of t (the finder's rule
- * and tau) closer than `bound`: t's vertices are near enough theirs, and
- * its arc rule's turns changed too little to admit a pair they left out.
- * The arc rule's sums must be t's (fill_prefix). */
-static bool near_holds(tk_strut_finder *f, const tk_curve *t, double bound)
+/* The farthest a vertex of t is from the near pairs' curve, or INFINITY
+ * when they cannot serve t: no pairs, other counts, or its arc rule's
+ * turns changed enough to admit a pair they left out.  The arc rule's
+ * sums must be t's (fill_prefix). */
+static double near_moved(const tk_strut_finder *f, const tk_curve *t)
 {
     if (!(f->near_reach > 0.0) || check_counts(f, t, NULL) != TK_OK)
-        return false;
-    /* a distance changes by at most twice the farthest a vertex moved */
-    double room = 0.5 * (f->near_tau + 2.0 * f->near_reach - bound);
-    if (!(room >= 0.0))
-        return false;
+        return INFINITY;
+    double moved2 = 0.0;
     for (size_t v = 0; v < t->nvert; v++) {
         const double *p = t->xyz + 3 * v, *q = f->near_of + 3 * v;
         double d[3] = {p[0] - q[0], p[1] - q[1], p[2] - q[2]};
-        if (tk_dot3(d, d) > room * room)
-            return false;
+        moved2 = fmax(moved2, tk_dot3(d, d));
     }
     /* a forward turn (and the rest of a closed component's) changed by at
      * most twice the range of the sums' change */
@@ -812,9 +808,17 @@ static bool near_holds(tk_strut_finder *f, const tk_curve *t, double bound)
             hi = fmax(hi, now[i] - then[i]);
         }
         if (2.0 * (hi - lo) > 0.5 * NEAR_ARC_SLACK)
-            return false;
+            return INFINITY;
     }
-    return true;
+    return sqrt(moved2);
+}
+
+/* Whether the last near pairs hold every pair of t (the finder's rule
+ * and tau) closer than `bound`: a distance changes by at most twice the
+ * farthest a vertex moved.  The arc rule's sums must be t's. */
+static bool near_holds(const tk_strut_finder *f, const tk_curve *t, double bound)
+{
+    return near_moved(f, t) <= 0.5 * (f->near_tau + 2.0 * f->near_reach - bound);
 }
 
 bool tk_strut_finder_closest_near(tk_strut_finder *f, const tk_curve *t, double below,
@@ -841,23 +845,29 @@ bool tk_strut_finder_closest_near(tk_strut_finder *f, const tk_curve *t, double 
     return true;
 }
 
-/* How far t's turns exceed what the admissible rule (with tau) allows
- * them, summed over the vertices: 0 when 2 minrad >= tau everywhere. */
-static double turn_excess(const tk_curve *t, double tau)
+/* The Fenchel rule's sums of t in place of the admissible rule's (which
+ * the prefix holds), and how far t's turns exceed the admissible weights,
+ * summed over the vertices: 0 when 2 minrad >= tau everywhere. */
+static double fenchel_over_admissible(tk_strut_finder *f, const tk_curve *t)
 {
     double excess = 0.0;
-    for (size_t k = 0; k < t->ncomp; k++)
-        for (size_t i = 0; i < tk_curve_comp_vertices(t, k); i++)
-            excess += fmax(vertex_weight(t, k, i, TK_ARC_FENCHEL, tau) -
-                               vertex_weight(t, k, i, TK_ARC_ADMISSIBLE, tau),
-                           0.0);
+    for (size_t k = 0; k < t->ncomp; k++) {
+        double *p = f->prefix + f->prefix_offset[k], admissible_before = p[0];
+        for (size_t i = 0; i < tk_curve_comp_vertices(t, k); i++) {
+            double admissible = p[i + 1] - admissible_before;
+            double turn = vertex_weight(t, k, i, TK_ARC_FENCHEL, 0.0);
+            admissible_before = p[i + 1];
+            excess += fmax(turn - admissible, 0.0);
+            p[i + 1] = p[i] + turn;
+        }
+    }
     return excess;
 }
 
 /* Why the admissible near pairs serve the Fenchel rule: a pair the
  * Fenchel rule allows at t turns by at least pi between its edges, so
  * the admissible weights there add up to at least pi minus t's excess;
- * near_holds bounds their change since the list was made by half of
+ * near_moved bounds their change since the list was made by half of
  * NEAR_ARC_SLACK, and an excess of a quarter more leaves the pair within
  * the slack the list was made with.  Its distance at t below `bound` was
  * below tau + 2 reach there. */
@@ -867,21 +877,12 @@ bool tk_strut_finder_shortest_near(tk_strut_finder *f, const tk_curve *t, double
     if (!(f->near_reach > 0.0) || f->near_rule != TK_ARC_ADMISSIBLE ||
         check_counts(f, t, NULL) != TK_OK)
         return false;
-    double moved2 = 0.0;
-    for (size_t v = 0; v < t->nvert; v++) {
-        const double *p = t->xyz + 3 * v, *q = f->near_of + 3 * v;
-        double d[3] = {p[0] - q[0], p[1] - q[1], p[2] - q[2]};
-        moved2 = fmax(moved2, tk_dot3(d, d));
-    }
-    /* (the margin is far above the rounding of a distance) */
-    double bound = (f->near_tau + 2.0 * (f->near_reach - sqrt(moved2))) * (1.0 - 1e-9);
-    if (!(bound > 0.0))
-        return false;
     fill_prefix(f, t, TK_ARC_ADMISSIBLE, f->near_tau);
-    if (!near_holds(f, t, bound) || !(turn_excess(t, f->near_tau) <= 0.25 * NEAR_ARC_SLACK))
+    /* (the margin is far above the rounding of a distance) */
+    double bound = (f->near_tau + 2.0 * (f->near_reach - near_moved(f, t))) * (1.0 - 1e-9);
+    if (!(bound > 0.0) || !(fenchel_over_admissible(f, t) <= 0.25 * NEAR_ARC_SLACK))
         return false;
     /* as the tree's search in shortest mode, over the near pairs */
-    fill_prefix(f, t, TK_ARC_FENCHEL, 0.0);
     query qy = {f, t, TK_ARC_FENCHEL, bound, true, false, {{0}}, NULL, TK_OK};
     for (size_t k = 0; k < f->nnear; k++)
         test_pair(&qy, f->near[2 * k], f->near[2 * k + 1]);
