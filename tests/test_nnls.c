@@ -1146,8 +1146,8 @@ START_TEST(proximal_problems)
 }
 END_TEST
 
-/* The flow's rounds (tk/nnls.h): the proximal weight shrinks tenfold a
- * round from 1e-2 to 1e-8, each round centred at the last answer, on wide
+/* Rounds of the proximal point method (tk/nnls.h) whose weight shrinks
+ * tenfold a round from 1e-2 to 1e-8, each centred at the last answer, on wide
  * flow problems whose passive sets hold more than half as many columns as
  * there are coordinates (so the solver's coordinate form, m x m, serves
  * them), with the fallback at the small weights: every answer meets its
@@ -1221,6 +1221,109 @@ START_TEST(proximal_rounds_on_wide_problems)
 }
 END_TEST
 
+
+/* The scaled largest difference of two answers, against the first's size. */
+static double answer_gap(const cholmod_sparse *A, const double *x, const double *y)
+{
+    double diff = 0.0, size = 0.0;
+    for (size_t j = 0; j < A->ncol; j++) {
+        double sj = column_norm(A, j);
+        diff = fmax(diff, sj * fabs(x[j] - y[j]));
+        size = fmax(size, sj * fabs(x[j]));
+    }
+    return size > 0.0 ? diff / size : diff;
+}
+
+/* A solve with x as the centre on a fresh solver (nothing kept): into y. */
+static tk_nnls_report fresh_solve(const cholmod_sparse *A, const double *b, const double *x,
+                                  double *y, const tk_nnls_options *o)
+{
+    tk_nnls *t = new_solver();
+    tk_nnls_report rep;
+    memcpy(y, x, A->ncol * sizeof *y);
+    ck_assert_int_eq(solve(t, A, b, y, o, &rep), TK_OK);
+    tk_nnls_free(&t);
+    return rep;
+}
+
+/* The coordinate form's factor kept from one solve to the next (tk/nnls.h):
+ * rounds of the proximal point method at one weight on a wide flow
+ * problem start from the last round's factor, with no factorisation of
+ * their own where the passive set changed little, and their answers are
+ * a fresh solver's.  A matrix with one entry changed, or another weight,
+ * is factored afresh; a matrix with a column fewer (another pattern, the
+ * same rows: the kept ordering) is solved as a fresh solver does. */
+START_TEST(kept_factor_serves_the_same_matrix_only)
+{
+    tk_nnls *s = new_solver();
+    cholmod_common *cc = tk_nnls_common(s);
+    tkt_rng r = {2027};
+    size_t V = 120;
+    cholmod_sparse *A = flow_matrix(cc, &r, V, 6 * V);
+    size_t m = A->nrow, n = A->ncol;
+    double *b = random_vector(&r, m);
+    double *x = calloc(n, sizeof *x), *y = calloc(n, sizeof *y), *c = calloc(n, sizeof *c);
+    ck_assert(x && y && c);
+    tk_nnls_options o = tight;
+    o.warm_start = true;
+    o.proximal = 1e-3;
+    int reused = 0;
+    for (int round = 0; round < 8; round++) {
+        memcpy(c, x, n * sizeof *c);
+        tk_nnls_report rep, fresh = fresh_solve(A, b, c, y, &o);
+        ck_assert_int_eq(solve(s, A, b, x, &o, &rep), TK_OK);
+        ck_assert_msg(2 * rep.passive > m, "round %d: %zu passive of %zu rows", round,
+                      rep.passive, m);
+        ck_assert_int_ge(fresh.factorisations, 1);
+        reused += round > 0 && rep.factorisations == 0;
+        double gap = answer_gap(A, y, x);
+        ck_assert_msg(gap <= 1e-9, "round %d: %g from a fresh solver's", round, gap);
+        assert_proximal_kkt(A, b, c, o.proximal, x, 1e-9, "kept factor");
+    }
+    ck_assert_int_gt(reused, 0);
+
+    /* one entry changed: the same pattern, another matrix */
+    double *Ax = A->x;
+    Ax[7] *= 1.001;
+    tk_nnls_report rep, fresh = fresh_solve(A, b, x, y, &o);
+    ck_assert_int_eq(solve(s, A, b, x, &o, &rep), TK_OK);
+    ck_assert_int_ge(rep.factorisations, 1);
+    ck_assert_msg(answer_gap(A, y, x) <= 1e-9, "changed entry: %g", answer_gap(A, y, x));
+    (void)fresh;
+
+    /* another weight */
+    tk_nnls_options o2 = o;
+    o2.proximal = 2e-3;
+    fresh_solve(A, b, x, y, &o2);
+    ck_assert_int_eq(solve(s, A, b, x, &o2, &rep), TK_OK);
+    ck_assert_int_ge(rep.factorisations, 1);
+    ck_assert_msg(answer_gap(A, y, x) <= 1e-9, "other weight: %g", answer_gap(A, y, x));
+
+    /* a column fewer */
+    int *keep = malloc(n * sizeof *keep);
+    ck_assert_ptr_nonnull(keep);
+    for (size_t j = 0; j + 1 < n; j++)
+        keep[j] = (int)(j < 11 ? j : j + 1);
+    cholmod_sparse *B = cholmod_submatrix(A, NULL, -1, keep, (long)(n - 1), 1, 1, cc);
+    ck_assert_ptr_nonnull(B);
+    for (size_t j = 11; j + 1 < n; j++)
+        x[j] = x[j + 1];
+    fresh_solve(B, b, x, y, &o);
+    ck_assert_int_eq(solve(s, B, b, x, &o, &rep), TK_OK);
+    ck_assert_int_ge(rep.factorisations, 1);
+    ck_assert_msg(answer_gap(B, y, x) <= 1e-9, "a column fewer: %g", answer_gap(B, y, x));
+
+    free(keep);
+    free(b);
+    free(x);
+    free(y);
+    free(c);
+    cholmod_free_sparse(&A, cc);
+    cholmod_free_sparse(&B, cc);
+    tk_nnls_free(&s);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("nnls");
@@ -1241,6 +1344,7 @@ int main(void)
     tcase_add_test(tc, two_threads_match_series);
     tcase_add_test(tc, proximal_problems);
     tcase_add_test(tc, proximal_rounds_on_wide_problems);
+    tcase_add_test(tc, kept_factor_serves_the_same_matrix_only);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);
 }

@@ -31,7 +31,12 @@
  * the n_F x n_F normal matrix (the coordinate form: far sparser there),
  * and block pivoting and Lawson and Hanson modify its factor with rank-one
  * updates and downdates (CHOLMOD's cholmod_updown) as columns join and
- * leave.  In that form, when block pivoting gives up, a primal-dual
+ * leave.  Its factor is kept after a solve: a next solve of the same
+ * matrix (the same entries of A) with the same mu starts from it, updated
+ * and downdated to its own passive set, instead of factoring afresh.  Its
+ * fill-reducing ordering of the rows is kept too, and serves a next
+ * matrix with other columns but as many rows while the factor stays
+ * about as sparse.  In that form, when block pivoting gives up, a primal-dual
  * interior point method finds the partition near the answer (a few dozen
  * factorisations of one pattern) and block pivoting starts again from it;
  * Lawson and Hanson come only after that.
@@ -92,6 +97,9 @@ typedef struct tk_nnls_report {
                                how far it leaves the residual from orthogonal
                                to A x */
     size_t passive;         /* number of x_i > 0 */
+    bool kept;              /* the coordinate form's factor is kept: a next
+                               solve of the same matrix and weight starts
+                               from it (see above) */
     int interior_steps;     /* of the interior point (coordinate form), 0
                                when block pivoting needed none */
 } tk_nnls_report;
