@@ -39,22 +39,38 @@ int tk_motion_fit(tk_run *r, size_t vertices, tk_error *err)
  * the last step.  The resolved motion v = u + A x then descends only
  * when the proximal term, -(A x) . v, is small against |v|^2 (see
  * tk_motion_descends): near a critical point v is small, so the solve is
- * repeated centred at its own answer (the proximal point method) with the
- * weight shrunk by MOTION_PROXIMAL_SHRINK each round (down to
- * MOTION_PROXIMAL_LEAST, where the problem is the plain one in all but
- * uniqueness) until the term is below MOTION_PROXIMAL_SHARE of |v|^2, at
- * most MOTION_PROXIMAL_ROUNDS times.  A fixed weight needs hundreds of
- * rounds where the forces change much (the unlink's first steps leave a
- * residual of 1.6e-4 after 20); a shrinking one reaches 2e-15.  The share
+ * repeated centred at its own answer (the proximal point method) until
+ * the term is below MOTION_PROXIMAL_SHARE of |v|^2, at most
+ * MOTION_PROXIMAL_ROUNDS times.  The weights follow what a round costs.
+ * Where every round is a factorisation (few contacts), the weight starts
+ * at MOTION_PROXIMAL and shrinks by MOTION_PROXIMAL_SHRINK every round (a
+ * fixed weight needs hundreds of rounds where the forces change much: the
+ * unlink's first steps leave a residual of 1.6e-4 after 20; a shrinking
+ * one reaches 2e-15), down to MOTION_PROXIMAL_LEAST, where the problem is
+ * the plain one in all but uniqueness.  Where the solver keeps its factor
+ * (tk/nnls.h: many contacts; known from the last solve), a round at the
+ * same weight costs a few solves with it, a new weight a factorisation,
+ * and weights of 1e-5 and less a hundred pivots and more: there the
+ * weight starts at MOTION_PROXIMAL_KEPT and only shrinks, by
+ * MOTION_PROXIMAL_HALVE, when a round leaves more than MOTION_PROXIMAL_SLOW
+ * of the last round's term.  Replayed on the NNLS problems of the first
+ * steps of three trefoils tightened again (bench/steps --curve), against
+ * the other rule: at 2,435 vertices, tight, 134 factorisations and 575
+ * pivots in 67 solves against 358 and 2,289; at 1,200, resampled, 668 and
+ * 3,544 in 49 against 2,583 and 16,060; at 4,800, resampled, 405 and 8,259
+ * in 53 against 668 and 5,480 (a few first rounds pivot more).  The share
  * trades rounds for descent: a generated chain of three rings at 303
  * vertices is at 43.79 after 2000 steps with 1e-4, 44.22 with 1e-2 and
  * 42.30 with 1e-6, while the catalogue trefoil's final 734-vertex polygon
  * (2160 struts, where rounds at a small weight need the slow Lawson and
  * Hanson phase) takes 255 steps in 26 s with 1e-4 against 50 with 1e-6. */
 #define MOTION_PROXIMAL 1e-2
-#define MOTION_PROXIMAL_SHARE 1e-4
-#define MOTION_PROXIMAL_ROUNDS 20
 #define MOTION_PROXIMAL_SHRINK 0.1
+#define MOTION_PROXIMAL_KEPT 1e-3
+#define MOTION_PROXIMAL_HALVE 0.5
+#define MOTION_PROXIMAL_SLOW 0.9
+#define MOTION_PROXIMAL_SHARE 1e-4
+#define MOTION_PROXIMAL_ROUNDS 40
 #define MOTION_PROXIMAL_LEAST 1e-12
 
 /* out = A x (3V entries). */
@@ -151,15 +167,22 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
     tk_nnls_options nopt = TK_NNLS_OPTIONS_INIT;
     nopt.warm_start = true;
     tk_active_guess_forces(r, r->motion.x);
-    double t0 = tk_clock();
+    double t0 = tk_clock(), last = INFINITY;
+    nopt.proximal = r->motion.kept ? MOTION_PROXIMAL_KEPT : MOTION_PROXIMAL;
     for (int round = 0; !rc && round < MOTION_PROXIMAL_ROUNDS; round++) {
-        nopt.proximal =
-            fmax(MOTION_PROXIMAL * pow(MOTION_PROXIMAL_SHRINK, round), MOTION_PROXIMAL_LEAST);
         rc = tk_nnls_solve(r->shared.nnls, a, work, r->motion.x, &nopt, &nr, err);
         r->motion.nnls_iterations += nr.iterations;
         r->motion.factorisations += nr.factorisations;
-        if (rc || !(fabs(nr.proximal_term) > MOTION_PROXIMAL_SHARE * nr.residual * nr.residual))
+        r->motion.kept = !rc && nr.kept;
+        double term = fabs(nr.proximal_term);
+        if (rc || !(term > MOTION_PROXIMAL_SHARE * nr.residual * nr.residual))
             break;
+        if (!nr.kept)
+            nopt.proximal *= MOTION_PROXIMAL_SHRINK;
+        else if (term > MOTION_PROXIMAL_SLOW * last)
+            nopt.proximal *= MOTION_PROXIMAL_HALVE;
+        nopt.proximal = fmax(nopt.proximal, MOTION_PROXIMAL_LEAST);
+        last = term;
     }
     r->motion.nnls_seconds += tk_clock() - t0;
     r->motion.nnls_solves++;

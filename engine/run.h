@@ -93,6 +93,7 @@ struct tk_run {
         double *work;    /* 3V */
         double *x;       /* compressions, one per constraint */
         size_t x_capacity;
+        bool kept;       /* the last solve's factor is kept (tk/nnls.h) */
         double nnls_seconds;
         long nnls_solves, nnls_iterations, factorisations;
     } motion;
