@@ -15,6 +15,7 @@
 #include <stdlib.h>
 
 #include "rng.h"
+#include "tk/geometry.h"
 
 /* Counts beyond which a generator refuses: the VECT reader's default
  * limits (TK_VECT_LIMITS_INIT), so that every generated curve reads back. */
@@ -311,6 +312,73 @@ int tk_generate_figure_eight(size_t vertices, tk_curve **out, tk_error *err)
         v[0] = (2.0 + c2) * c3;
         v[1] = (2.0 + c2) * s3;
         v[2] = s4;
+    }
+    return TK_OK;
+}
+
+/* Whether closed component 0 of c keeps its edges apart: no two edges
+ * that share no vertex come closer than `gap` (every pair, brute force). */
+static bool edges_apart(const tk_curve *c, double gap)
+{
+    size_t n = c->nvert;
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = i + 2; j < n; j++) {
+            if (i == 0 && j == n - 1)
+                continue;
+            tk_closest cl;
+            tk_segment_closest(tk_curve_vertex(c, i), tk_curve_vertex(c, i + 1),
+                               tk_curve_vertex(c, j), tk_curve_vertex(c, (j + 1) % n), &cl);
+            if (!(cl.dist > gap))
+                return false;
+        }
+    return true;
+}
+
+int tk_generate_lissajous(const int freq[3], const double phase[3], size_t vertices,
+                          tk_curve **out, tk_error *err)
+{
+    *out = NULL;
+    int fastest = 0;
+    for (int k = 0; k < 3; k++) {
+        if (freq[k] < 1 || freq[k] > 1000)
+            return tk_error_set(err, TK_EINVAL,
+                                "a Lissajous frequency must be 1 to 1000 (got %d)", freq[k]);
+        if (!isfinite(phase[k]))
+            return tk_error_set(err, TK_EINVAL, "a Lissajous phase must be finite");
+        if (gcd_size((size_t)freq[k], (size_t)freq[(k + 1) % 3]) != 1)
+            return tk_error_set(err, TK_EINVAL,
+                                "the Lissajous frequencies %d and %d are not coprime: the "
+                                "curve would run over itself",
+                                freq[k], freq[(k + 1) % 3]);
+        if (freq[k] > fastest)
+            fastest = freq[k];
+    }
+    size_t n;
+    int rc = check_counts(vertices, 60 * (size_t)fastest, 1, &n, err);
+    if (rc)
+        return rc;
+    if (n < 12 * (size_t)fastest)
+        return tk_error_set(err, TK_EINVAL,
+                            "this Lissajous knot needs at least %zu vertices (12 a turn of its "
+                            "fastest angle; asked for %zu)",
+                            12 * (size_t)fastest, n);
+    if ((rc = new_closed(1, n, out, err)) != TK_OK)
+        return rc;
+    for (size_t i = 0; i < n; i++) {
+        double *v = tk_curve_vertex(*out, i);
+        for (int k = 0; k < 3; k++) {
+            double co, si;
+            unit_circle((size_t)freq[k] * i % n, n, &co, &si);
+            /* cos(a + p) = cos a cos p - sin a sin p */
+            v[k] = co * cos(phase[k]) - si * sin(phase[k]) + 0.0;
+        }
+    }
+    /* the curve lies in [-1, 1]^3: a gap below 1e-9 is a crossing */
+    if (!edges_apart(*out, 1e-9)) {
+        tk_curve_free(out);
+        return tk_error_set(err, TK_EINVAL,
+                            "the Lissajous curve with phases (%g, %g, %g) passes through itself",
+                            phase[0], phase[1], phase[2]);
     }
     return TK_OK;
 }

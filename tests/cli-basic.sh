@@ -237,6 +237,21 @@ expect_match 'trefoil\.vect +1 +[0-9]+ .* det 3, 1 - t \+ t\^2$' "$tmp/out" "inf
 expect_status 0 "info on a disguised figure-eight" "$tk" info --json "$tmp/fig8.vect"
 expect_match '"alexander":\[\[-1,3,-1\]\],"alexander_text":\["-1 \+ 3t - t\^2"\],"determinants":\[5\]' \
     "$tmp/out" "info --json: the figure-eight's type"
+# Lissajous knots: (3, 2, 5) is 6_1 (2 - 5t + 2t^2, determinant 9), with
+# (3, 2, 7) and phases 0.7 0.7 0 the knot 5_2 (determinant 7); frequencies
+# that are not coprime and phases that retrace the curve are usage errors.
+"$tk" generate lissajous 3 2 5 --vertices 120 >"$tmp/l325.vect"
+expect_status 0 "info on Lissajous (3, 2, 5)" "$tk" info --json "$tmp/l325.vect"
+expect_match '"alexander":\[\[-2,5,-2\]\],"alexander_text":\["-2 \+ 5t - 2t\^2"\],"determinants":\[9\]' \
+    "$tmp/out" "info --json: Lissajous (3, 2, 5) is 6_1"
+expect_value vertices 120 "$tmp/out" "Lissajous --vertices"
+"$tk" generate lissajous 3 2 7 0.7 0.7 0 >"$tmp/l327.vect"
+expect_status 0 "info on Lissajous (3, 2, 7)" "$tk" info --json "$tmp/l327.vect"
+expect_match '"determinants":\[7\]' "$tmp/out" "info --json: Lissajous (3, 2, 7) is 5_2"
+expect_status 1 "Lissajous frequencies not coprime" "$tk" generate lissajous 3 2 6
+expect_match 'not coprime' "$tmp/err" "Lissajous: the frequencies named"
+expect_status 1 "Lissajous retracing itself" "$tk" generate lissajous 3 2 5 0 0 0
+expect_match 'passes through itself' "$tmp/err" "Lissajous: the phases named"
 expect_status 0 "info --json on hopf" "$tk" info --json "$tmp/hopf.vect"
 expect_match '"determinants":\[1,1\],"linking":(\[\[0,1\],\[1,0\]\]|\[\[0,-1\],\[-1,0\]\]),"complete":true' \
     "$tmp/out" "info --json: the Hopf link's linking number"

@@ -4,6 +4,7 @@
 #include <check.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "support.h"
 #include "tk/curve.h"
@@ -369,6 +370,45 @@ START_TEST(invalid_arguments)
 }
 END_TEST
 
+/* The Lissajous knot: each vertex on the curve at its parameter (against
+ * cos from libm), the default count 60 a turn of the fastest angle, and
+ * the curves it must refuse: frequencies not coprime, too few vertices,
+ * phases that make it retrace itself (all 0: K(-t) = K(t)) or are not
+ * finite. */
+START_TEST(lissajous_curve)
+{
+    const int freq[3] = {3, 2, 5};
+    const double phase[3] = {0.7, 0.2, 0.0};
+    tk_curve *c = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_generate_lissajous(freq, phase, 0, &c, &err), TK_OK);
+    ck_assert_uint_eq(c->nvert, 300);
+    ck_assert_uint_eq(c->ncomp, 1);
+    ck_assert(c->closed[0]);
+    for (size_t i = 0; i < c->nvert; i++) {
+        double t = 2.0 * M_PI * (double)i / 300.0;
+        for (int k = 0; k < 3; k++)
+            ck_assert_msg(fabs(tk_curve_vertex(c, i)[k] - cos(freq[k] * t + phase[k])) < 1e-14,
+                          "vertex %zu coordinate %d", i, k);
+    }
+    tk_curve_free(&c);
+    ck_assert_int_eq(tk_generate_lissajous(freq, phase, 60, &c, &err), TK_OK);
+    ck_assert_uint_eq(c->nvert, 60);
+    tk_curve_free(&c);
+    ck_assert_int_eq(tk_generate_lissajous(freq, phase, 59, &c, &err), TK_EINVAL);
+    ck_assert_ptr_null(c);
+    const int shared[3] = {3, 2, 6}, zero[3] = {0, 2, 5};
+    ck_assert_int_eq(tk_generate_lissajous(shared, phase, 0, &c, &err), TK_EINVAL);
+    ck_assert_ptr_nonnull(strstr(err.message, "coprime"));
+    ck_assert_int_eq(tk_generate_lissajous(zero, phase, 0, &c, &err), TK_EINVAL);
+    const double still[3] = {0.0, 0.0, 0.0}, bad[3] = {0.7, NAN, 0.0};
+    ck_assert_int_eq(tk_generate_lissajous(freq, still, 0, &c, &err), TK_EINVAL);
+    ck_assert_ptr_nonnull(strstr(err.message, "passes through itself"));
+    ck_assert_int_eq(tk_generate_lissajous(freq, bad, 0, &c, &err), TK_EINVAL);
+    ck_assert_ptr_null(c);
+}
+END_TEST
+
 static Suite *generate_suite(void)
 {
     Suite *s = suite_create("generate");
@@ -383,6 +423,7 @@ static Suite *generate_suite(void)
     tcase_add_test(tc, borromean_rings);
     tcase_add_test(tc, chain_rings);
     tcase_add_test(tc, invalid_arguments);
+    tcase_add_test(tc, lissajous_curve);
     suite_add_tcase(s, tc);
     return s;
 }

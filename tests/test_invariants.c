@@ -386,6 +386,24 @@ START_TEST(torus_knot_alexander_polynomials)
         tk_curve_vertex(c, v)[2] *= -1.0;
     assert_alexander(c, 0, eight, 2, "mirrored figure-eight");
     tk_curve_free(&c);
+    /* Lissajous knots: 6_1 (2 - 5t + 2t^2, at two counts and disguised)
+     * and 5_2 (2 - 3t + 2t^2) */
+    const int f325[3] = {3, 2, 5}, f327[3] = {3, 2, 7};
+    const double p6[3] = {0.7, 0.2, 0.0}, p5[3] = {0.7, 0.7, 0.0};
+    const long long six[] = {-2, 5, -2}, five[] = {2, -3, 2};
+    ck_assert_int_eq(tk_generate_lissajous(f325, p6, 0, &c, NULL), TK_OK);
+    assert_alexander(c, 0, six, 2, "Lissajous (3, 2, 5)");
+    tk_curve *d = NULL;
+    ck_assert_int_eq(tk_generate_disguise(c, 47, 0.05, &d, NULL), TK_OK);
+    assert_alexander(d, 0, six, 2, "Lissajous (3, 2, 5) disguised");
+    tk_curve_free(&d);
+    tk_curve_free(&c);
+    ck_assert_int_eq(tk_generate_lissajous(f325, p6, 60, &c, NULL), TK_OK);
+    assert_alexander(c, 0, six, 2, "Lissajous (3, 2, 5) at 60 vertices");
+    tk_curve_free(&c);
+    ck_assert_int_eq(tk_generate_lissajous(f327, p5, 0, &c, NULL), TK_OK);
+    assert_alexander(c, 0, five, 2, "Lissajous (3, 2, 7)");
+    tk_curve_free(&c);
     tk_curve *round = tkt_regular_polygon(40, 2.0);
     const long long one[] = {1};
     assert_alexander(round, 0, one, 0, "a round polygon");

@@ -2,7 +2,7 @@
  *
  *   tightknot info [--json] [--tolerance EPS] FILE...
  *   tightknot struts [--json] [--tolerance EPS] FILE
- *   tightknot generate torus P Q | figure-eight | hopf | borromean | chain K
+ *   tightknot generate torus P Q | figure-eight | lissajous NX NY NZ | hopf | borromean | chain K
  *                      [--vertices N] [--disguise SEED]
  *   tightknot tighten FILE [run options] [-o OUT] [--struts OUT] [--log OUT]
  *                    [--snapshots DIR --every K] [--json]
@@ -163,6 +163,12 @@ static const char generate_help[] =
     "              trefoil, T(2,4) a two-component link)\n"
     "  figure-eight  the figure-eight knot ((2 + cos 2t) cos 3t,\n"
     "              (2 + cos 2t) sin 3t, sin 4t)\n"
+    "  lissajous NX NY NZ [PX PY PZ]\n"
+    "              the Lissajous knot (cos(NX t + PX), cos(NY t + PY),\n"
+    "              cos(NZ t + PZ)): frequencies pairwise coprime, 1 to 1000;\n"
+    "              phases default 0.7 0.2 0.  3 2 5 is the knot 6_1, 3 2 7\n"
+    "              0.7 0.7 0 the knot 5_2; 'tightknot info' shows the type.\n"
+    "              Phases that make the curve pass through itself are refused\n"
     "  hopf        the Hopf link: two circles of radius 1 in perpendicular\n"
     "              planes, each through the other's centre (tight at\n"
     "              thickness 1: ropelength 8 pi); N is rounded up to even\n"
@@ -173,7 +179,9 @@ static const char generate_help[] =
     "\n"
     "Options:\n"
     "  --vertices N   vertices per component (default: torus about 40 per\n"
-    "                 turn, at least 60; hopf 64; borromean 96; chain 64).\n"
+    "                 turn, at least 60; figure-eight 200; lissajous 60 per\n"
+    "                 turn of the fastest angle, at least 12; hopf 64;\n"
+    "                 borromean 96; chain 64).\n"
     "                 Too few to keep the polygon embedded is refused.\n"
     "  --disguise SEED   the same knot or link as another start would give\n"
     "                 it: vertices moved along each component to uneven\n"
@@ -191,7 +199,8 @@ static const char generate_help[] =
     "\n"
     "Example:\n"
     "  tightknot generate torus 2 3 --vertices 150 > trefoil.vect\n"
-    "  tightknot generate figure-eight --disguise 7 > figure-eight.vect\n";
+    "  tightknot generate figure-eight --disguise 7 > figure-eight.vect\n"
+    "  tightknot generate lissajous 3 2 5 > 6_1.vect\n";
 
 static const char tighten_help[] =
     "usage: tightknot tighten FILE [OPTIONS]\n"
@@ -299,6 +308,17 @@ static int parse_integer(const char *cmd, const char *what, const char *text,
     if (end == text || *end != '\0' || errno == ERANGE || x < lo || x > hi)
         return usage_error(cmd, "%s: '%s' is not an integer from %lld to %lld", what,
                            text, lo, hi);
+    *out = x;
+    return EXIT_OK;
+}
+
+static int parse_real(const char *cmd, const char *what, const char *text, double *out)
+{
+    char *end = NULL;
+    errno = 0;
+    double x = strtod(text, &end);
+    if (end == text || *end != '\0' || errno == ERANGE || !isfinite(x))
+        return usage_error(cmd, "%s: '%s' is not a finite number", what, text);
     *out = x;
     return EXIT_OK;
 }
@@ -613,8 +633,8 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
 {
     const char *cmd = "generate";
     if (npos == 0)
-        return usage_error(cmd, "no SHAPE given (torus P Q, figure-eight, hopf, borromean or "
-                                "chain K)");
+        return usage_error(cmd, "no SHAPE given (torus P Q, figure-eight, lissajous NX NY NZ, "
+                                "hopf, borromean or chain K)");
     const char *shape = pos[0];
     tk_error err;
     tk_error_clear(&err);
@@ -634,6 +654,22 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
         rc = shape[0] == 'h'   ? tk_generate_hopf(vertices, out, &err)
              : shape[0] == 'b' ? tk_generate_borromean(vertices, out, &err)
                                : tk_generate_figure_eight(vertices, out, &err);
+    } else if (strcmp(shape, "lissajous") == 0) {
+        if (npos != 4 && npos != 7)
+            return usage_error(cmd, "lissajous takes three frequencies NX NY NZ and "
+                                    "optionally three phases PX PY PZ");
+        static const char *names[] = {"lissajous NX", "lissajous NY", "lissajous NZ",
+                                      "lissajous PX", "lissajous PY", "lissajous PZ"};
+        int freq[3];
+        double phase[3] = {0.7, 0.2, 0.0};
+        for (int k = 0; k < 3; k++) {
+            long long f = 0;
+            if (parse_integer(cmd, names[k], pos[1 + k], 1, 1000, &f) ||
+                (npos == 7 && parse_real(cmd, names[3 + k], pos[4 + k], &phase[k])))
+                return EXIT_USAGE;
+            freq[k] = (int)f;
+        }
+        rc = tk_generate_lissajous(freq, phase, vertices, out, &err);
     } else if (strcmp(shape, "chain") == 0) {
         if (npos != 2)
             return usage_error(cmd, "chain takes one argument, K");
@@ -643,8 +679,8 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
         rc = tk_generate_chain((size_t)k, vertices, out, &err);
     } else {
         return usage_error(cmd,
-                           "unknown shape '%s' (torus P Q, figure-eight, hopf, borromean or "
-                           "chain K)",
+                           "unknown shape '%s' (torus P Q, figure-eight, lissajous NX NY NZ, "
+                           "hopf, borromean or chain K)",
                            shape);
     }
     if (rc == TK_EINVAL || rc == TK_ELIMIT)

@@ -36,6 +36,19 @@ int tk_generate_chain(size_t k, size_t vertices, tk_curve **out,
  * (a start that is far from tight and, unlike the catalogue's, symmetric). */
 int tk_generate_figure_eight(size_t vertices, tk_curve **out, tk_error *err);
 
+/* The Lissajous knot (cos(nx t + px), cos(ny t + py), cos(nz t + pz)),
+ * t in [0, 2 pi), freq = (nx, ny, nz) pairwise coprime and >= 1, phase =
+ * (px, py, pz).  Its projection on the xy plane has 2 nx ny - nx - ny
+ * crossings.  (3, 2, 5) with phases (0.7, 0.2, 0) is the knot 6_1,
+ * (3, 2, 7) with (0.7, 0.7, 0) the knot 5_2 (Bogle, Hearst, Jones and
+ * Stoilov, Lissajous knots, 1994; tightknot info shows the type).  At
+ * least 12 vertices per turn of the fastest angle (default 60), so that
+ * every edge turns that angle by less than pi / 6; phases for which the
+ * polygon passes through itself (all 0, for one) are refused
+ * (TK_EINVAL). */
+int tk_generate_lissajous(const int freq[3], const double phase[3], size_t vertices,
+                          tk_curve **out, tk_error *err);
+
 /* The same knot or link, disguised: each component's vertices moved along
  * it to uneven spacing (arclength s -> s + 0.3 L sin(2 pi s / L + phase)
  * / (2 pi), spacing ratio up to 1.86), each vertex displaced by a normal
