@@ -49,7 +49,7 @@ static const struct {
              {"6_1", 480, ROPE_6_1},    {"8_19", 489, ROPE_8_19}, {"10_124", 576, ROPE_10_124},
              {"Hopf", 202, 25.14142}};
 
-typedef enum maker { FILE_START, TORUS, FIGURE_EIGHT, HOPF, CHAIN } maker;
+typedef enum maker { FILE_START, TORUS, FIGURE_EIGHT, LISSAJOUS, HOPF, CHAIN } maker;
 
 /* A start: a catalogue file or a generator, then a disguise (seed 0: none). */
 typedef struct start {
@@ -62,6 +62,8 @@ typedef struct start {
     size_t vertices;    /* generators: per component (0: default) */
     unsigned long long seed;
     double perturbation;
+    int freq[3];        /* LISSAJOUS */
+    double phase[3];
 } start;
 
 static const start starts[] = {
@@ -78,6 +80,8 @@ static const start starts[] = {
     {"T(2,5)~", "5_1", ROPE_5_1, TORUS, NULL, 2, 5, 200, 15, 0.01},
     {"6.1", "6_1", ROPE_6_1, FILE_START, "6.1", 0, 0, 0, 0, 0},
     {"6.1~", "6_1", ROPE_6_1, FILE_START, "6.1", 0, 0, 0, 16, 0.05},
+    {"L(3,2,5)", "6_1", ROPE_6_1, LISSAJOUS, NULL, 0, 0, 300, 0, 0, {3, 2, 5}, {0.7, 0.2, 0}},
+    {"L(3,2,5)~", "6_1", ROPE_6_1, LISSAJOUS, NULL, 0, 0, 300, 21, 0.01, {3, 2, 5}, {0.7, 0.2, 0}},
     {"8.19", "8_19", ROPE_8_19, FILE_START, "8.19", 0, 0, 0, 0, 0},
     {"T(3,4)", "8_19", ROPE_8_19, TORUS, NULL, 3, 4, 240, 0, 0},
     {"T(3,4)~", "8_19", ROPE_8_19, TORUS, NULL, 3, 4, 240, 17, 0.01},
@@ -107,6 +111,9 @@ static tk_curve *make_start(const start *s, const char *dir, tk_error *err)
         break;
     case FIGURE_EIGHT:
         rc = tk_generate_figure_eight(s->vertices, &c, err);
+        break;
+    case LISSAJOUS:
+        rc = tk_generate_lissajous(s->freq, s->phase, s->vertices, &c, err);
         break;
     case HOPF:
         rc = tk_generate_hopf(s->vertices, &c, err);
