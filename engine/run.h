@@ -216,9 +216,17 @@ int tk_type_check(tk_run *r, const char *when, tk_error *err);
  * first contact the thickness is often one vertex's curvature bound,
  * which wavers from step to step, and a run still falling by 0.4% in 300
  * steps (T(3,7) at 10,000 vertices) ended its window on a spike above
- * the ropelength 300 steps before and was taken for converged.  False
- * (and *fall untouched) while the history since `from` holds no more
- * than `window` entries. */
+ * the ropelength 300 steps before and was taken for converged.  A rise
+ * is a negative fall, and the callers take it as they take a small fall:
+ * no progress at this level, polish or try.  Near a critical point the
+ * ropelength rises and falls by up to 1e-4 a window while the step is
+ * too long for the polygon: the catalogue trefoil to its critical point
+ * (tests/test_tighten.c) ends at 32.7704 after 1600 steps, and at 32.7766
+ * when a rise of more than the threshold does not count as settled.
+ * (A loose curve's rise, its narrowest gap opening before the strands
+ * close in, is kept from being read as one: autoscale keeps such a curve
+ * at the tube.)  False (and *fall untouched) while the history since
+ * `from` holds no more than `window` entries. */
 bool tk_history_fall(const tk_run *r, size_t from, size_t window, double *fall);
 
 /* ---- active.c ---- */
