@@ -41,16 +41,18 @@ int tk_motion_fit(tk_run *r, size_t vertices, tk_error *err)
  * tk_motion_descends): near a critical point v is small, so the solve is
  * repeated centred at its own answer (the proximal point method) until
  * the term is below MOTION_PROXIMAL_SHARE of |v|^2, at most
- * MOTION_PROXIMAL_ROUNDS times.  The weights follow what a round costs.
+ * MOTION_PROXIMAL_ROUNDS times (MOTION_PROXIMAL_KEPT_ROUNDS where rounds
+ * are cheap, below).  The weights follow what a round costs.
  * Where every round is a factorisation (few contacts), the weight starts
  * at MOTION_PROXIMAL and shrinks by MOTION_PROXIMAL_SHRINK every round (a
  * fixed weight needs hundreds of rounds where the forces change much: the
  * unlink's first steps leave a residual of 1.6e-4 after 20; a shrinking
  * one reaches 2e-15), down to MOTION_PROXIMAL_LEAST, where the problem is
  * the plain one in all but uniqueness.  Where the solver keeps its factor
- * (tk/nnls.h: many contacts; known from the last solve), a round at the
- * same weight costs a few solves with it, a new weight a factorisation,
- * and weights of 1e-5 and less a hundred pivots and more: there the
+ * (tk/nnls.h: many contacts; known from the last solve) and the curve has
+ * at least MOTION_KEPT_VERTICES vertices, a round at the same weight costs
+ * a few solves with it, a new weight a factorisation of some 20 ms, and
+ * weights of 1e-5 and less a hundred pivots and more: there the
  * weight starts at MOTION_PROXIMAL_KEPT and only shrinks, by
  * MOTION_PROXIMAL_HALVE, when a round leaves more than MOTION_PROXIMAL_SLOW
  * of the last round's term.  Replayed on the NNLS problems of the first
@@ -58,7 +60,12 @@ int tk_motion_fit(tk_run *r, size_t vertices, tk_error *err)
  * the other rule: at 2,435 vertices, tight, 134 factorisations and 575
  * pivots in 67 solves against 358 and 2,289; at 1,200, resampled, 668 and
  * 3,544 in 49 against 2,583 and 16,060; at 4,800, resampled, 405 and 8,259
- * in 53 against 668 and 5,480 (a few first rounds pivot more).  The share
+ * in 53 against 668 and 5,480 (a few first rounds pivot more).  On a
+ * small curve a factorisation costs about what a round does, and at a
+ * critical point, where the answer's residual tends to 0 (the unlink's
+ * two round circles, 30 vertices), the term falls only as fast as the
+ * residual at one weight: 40 rounds left a residual of 5e-11 where the
+ * shrinking weight reaches 2e-15.  The share
  * trades rounds for descent: a generated chain of three rings at 303
  * vertices is at 43.79 after 2000 steps with 1e-4, 44.22 with 1e-2 and
  * 42.30 with 1e-6, while the catalogue trefoil's final 734-vertex polygon
@@ -66,11 +73,13 @@ int tk_motion_fit(tk_run *r, size_t vertices, tk_error *err)
  * Hanson phase) takes 255 steps in 26 s with 1e-4 against 50 with 1e-6. */
 #define MOTION_PROXIMAL 1e-2
 #define MOTION_PROXIMAL_SHRINK 0.1
+#define MOTION_KEPT_VERTICES 1000
 #define MOTION_PROXIMAL_KEPT 1e-3
 #define MOTION_PROXIMAL_HALVE 0.5
 #define MOTION_PROXIMAL_SLOW 0.9
 #define MOTION_PROXIMAL_SHARE 1e-4
-#define MOTION_PROXIMAL_ROUNDS 40
+#define MOTION_PROXIMAL_ROUNDS 20
+#define MOTION_PROXIMAL_KEPT_ROUNDS 40
 #define MOTION_PROXIMAL_LEAST 1e-12
 
 /* out = A x (3V entries). */
@@ -168,8 +177,11 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
     nopt.warm_start = true;
     tk_active_guess_forces(r, r->motion.x);
     double t0 = tk_clock(), last = INFINITY;
-    nopt.proximal = r->motion.kept ? MOTION_PROXIMAL_KEPT : MOTION_PROXIMAL;
-    for (int round = 0; !rc && round < MOTION_PROXIMAL_ROUNDS; round++) {
+    bool large = c->nvert >= MOTION_KEPT_VERTICES;
+    nopt.proximal = large && r->motion.kept ? MOTION_PROXIMAL_KEPT : MOTION_PROXIMAL;
+    for (int round = 0; !rc && round < (large && r->motion.kept ? MOTION_PROXIMAL_KEPT_ROUNDS
+                                                                 : MOTION_PROXIMAL_ROUNDS);
+         round++) {
         rc = tk_nnls_solve(r->shared.nnls, a, work, r->motion.x, &nopt, &nr, err);
         r->motion.nnls_iterations += nr.iterations;
         r->motion.factorisations += nr.factorisations;
@@ -177,7 +189,7 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
         double term = fabs(nr.proximal_term);
         if (rc || !(term > MOTION_PROXIMAL_SHARE * nr.residual * nr.residual))
             break;
-        if (!nr.kept)
+        if (!large || !nr.kept)
             nopt.proximal *= MOTION_PROXIMAL_SHRINK;
         else if (term > MOTION_PROXIMAL_SLOW * last)
             nopt.proximal *= MOTION_PROXIMAL_HALVE;
