@@ -334,6 +334,9 @@ static bool edges_apart(const tk_curve *c, double gap)
     return true;
 }
 
+/* edges_apart compares every pair of edges: about 2 s at 10,000 vertices. */
+#define LISSAJOUS_MAX_VERTICES 10000
+
 int tk_generate_lissajous(const int freq[3], const double phase[3], size_t vertices,
                           tk_curve **out, tk_error *err)
 {
@@ -357,6 +360,11 @@ int tk_generate_lissajous(const int freq[3], const double phase[3], size_t verti
     int rc = check_counts(vertices, 60 * (size_t)fastest, 1, &n, err);
     if (rc)
         return rc;
+    if (n > LISSAJOUS_MAX_VERTICES)
+        return tk_error_set(err, TK_ELIMIT,
+                            "a Lissajous knot has at most %zu vertices (asked for %zu): "
+                            "tighten --vertices resamples it",
+                            (size_t)LISSAJOUS_MAX_VERTICES, n);
     if (n < 12 * (size_t)fastest)
         return tk_error_set(err, TK_EINVAL,
                             "this Lissajous knot needs at least %zu vertices (12 a turn of its "

@@ -396,6 +396,7 @@ START_TEST(lissajous_curve)
     ck_assert_uint_eq(c->nvert, 60);
     tk_curve_free(&c);
     ck_assert_int_eq(tk_generate_lissajous(freq, phase, 59, &c, &err), TK_EINVAL);
+    ck_assert_int_eq(tk_generate_lissajous(freq, phase, 10001, &c, &err), TK_ELIMIT);
     ck_assert_ptr_null(c);
     const int shared[3] = {3, 2, 6}, zero[3] = {0, 2, 5};
     ck_assert_int_eq(tk_generate_lissajous(shared, phase, 0, &c, &err), TK_EINVAL);

@@ -43,9 +43,9 @@ int tk_generate_figure_eight(size_t vertices, tk_curve **out, tk_error *err);
  * (3, 2, 7) with (0.7, 0.7, 0) the knot 5_2 (Bogle, Hearst, Jones and
  * Stoilov, Lissajous knots, 1994; tightknot info shows the type).  At
  * least 12 vertices per turn of the fastest angle (default 60), so that
- * every edge turns that angle by less than pi / 6; phases for which the
- * polygon passes through itself (all 0, for one) are refused
- * (TK_EINVAL). */
+ * every edge turns that angle by less than pi / 6, and at most 10,000
+ * (TK_ELIMIT); phases for which the polygon passes through itself (all 0,
+ * for one) are refused (TK_EINVAL). */
 int tk_generate_lissajous(const int freq[3], const double phase[3], size_t vertices,
                           tk_curve **out, tk_error *err);
 
