@@ -58,9 +58,9 @@ int tk_motion_fit(tk_run *r, size_t vertices, tk_error *err)
  * of the last round's term.  Replayed on the NNLS problems of the first
  * steps of three trefoils tightened again (bench/steps --curve), against
  * the other rule: at 2,435 vertices, tight, 134 factorisations and 575
- * pivots in 67 solves against 358 and 2,289; at 1,200, resampled, 668 and
- * 3,544 in 49 against 2,583 and 16,060; at 4,800, resampled, 405 and 8,259
- * in 53 against 668 and 5,480 (a few first rounds pivot more).  On a
+ * pivots in 67 solves against 374 and 2,311; at 1,200, resampled, 667 and
+ * 3,544 in 49 against 2,581 and 15,536; at 4,800, resampled, 405 and 8,259
+ * in 53 against 871 and 6,430 (a few first rounds pivot more).  On a
  * small curve a factorisation costs about what a round does, and at a
  * critical point, where the answer's residual tends to 0 (the unlink's
  * two round circles, 30 vertices), the term falls only as fast as the
