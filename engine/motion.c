@@ -178,11 +178,10 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
     nopt.warm_start = true;
     tk_active_guess_forces(r, r->motion.x);
     double t0 = tk_clock(), last = INFINITY;
-    bool large = c->nvert >= MOTION_KEPT_VERTICES;
-    nopt.proximal = large && r->motion.kept ? MOTION_PROXIMAL_KEPT : MOTION_PROXIMAL;
-    for (int round = 0; !rc && round < (large && r->motion.kept ? MOTION_PROXIMAL_KEPT_ROUNDS
-                                                                 : MOTION_PROXIMAL_ROUNDS);
-         round++) {
+    bool large = c->nvert >= MOTION_KEPT_VERTICES, cheap = large && r->motion.kept;
+    nopt.proximal = cheap ? MOTION_PROXIMAL_KEPT : MOTION_PROXIMAL;
+    int most = cheap ? MOTION_PROXIMAL_KEPT_ROUNDS : MOTION_PROXIMAL_ROUNDS;
+    for (int round = 0; !rc && round < most; round++) {
         rc = tk_nnls_solve(r->shared.nnls, a, work, r->motion.x, &nopt, &nr, err);
         r->motion.nnls_iterations += nr.iterations;
         r->motion.factorisations += nr.factorisations;
