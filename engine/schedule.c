@@ -34,6 +34,16 @@
  * per unit ropelength, and at most this many halvings are undone. */
 #define COARSEST_RESOLUTION 2.5
 #define MAX_COARSE_LEVELS 3
+/* A coarse polygon follows the ropelength down: each time it has fallen
+ * by this fraction, the coarse level is resampled to its resolution at
+ * the ropelength reached (tk_schedule_before_step).  A loose start's
+ * coarse level is otherwise reckoned from its start's ropelength and as
+ * much finer than it needs to be when it is tight, all level long:
+ * Lissajous 6_1 L(3,2,5) (ropelength 429) had a coarse level of 1073
+ * vertices at resolution 5, spent the level's 60 s of a 120 s budget
+ * coming down to 89, got a final polygon of 446 vertices for that, and
+ * ended at 57.25 (+0.94%). */
+#define COARSE_RE_RESOLVE 0.25
 /* The largest ropelength a run starts from.  Autoscaled, such a curve's
  * coordinates reach about this many diameters, and rounding then moves
  * them by 1e-16 of that: beyond 1e9 the rounding approaches the
@@ -510,15 +520,17 @@ int tk_schedule_before_step(tk_run *r, tk_error *err)
     keep_at_tube(r);
     if (r->schedule.move_on)
         return refine(r, err);
-    if (!(o->re_resolve > 0.0) || !(o->resolution > 0.0) || !isfinite(rope))
+    double fraction = o->re_resolve > 0.0 || tk_schedule_final(r) ? o->re_resolve
+                                                                   : COARSE_RE_RESOLVE;
+    if (!(fraction > 0.0) || !(o->resolution > 0.0) || !isfinite(rope))
         return TK_OK;
     if (!isfinite(r->schedule.resolved_at)) {
         r->schedule.resolved_at = rope;
         return TK_OK;
     }
     double want = (double)level_count(r, rope);
-    if (!(rope < r->schedule.resolved_at * (1.0 - o->re_resolve)) ||
-        !(want < (double)r->shared.curve->nvert * (1.0 - o->re_resolve)))
+    if (!(rope < r->schedule.resolved_at * (1.0 - fraction)) ||
+        !(want < (double)r->shared.curve->nvert * (1.0 - fraction)))
         return TK_OK;
     return resample_to(r, (size_t)want, err);
 }

@@ -1182,10 +1182,14 @@ START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
     const tk_step_report *h = tk_run_history(run, &nh);
     size_t restarts = 0, refinements = 0;
     for (size_t i = 1; i < nh; i++) {
-        if (h[i].vertices < h[i - 1].vertices) {
+        if (h[i].escapes > h[i - 1].escapes) {
             /* an escape: back to the coarse level of the same reference */
             ck_assert_uint_eq(h[i].vertices, again);
             restarts++;
+        } else if (h[i].vertices < h[i - 1].vertices) {
+            /* the first coarse level following the ropelength down */
+            ck_assert_uint_eq(h[i].vertices, (size_t)ceil(2.5 * h[i - 1].ropelength));
+            ck_assert_uint_eq(refinements, 0);
         } else if (h[i].vertices > h[i - 1].vertices) {
             ck_assert_uint_eq(h[i].vertices, final);
             refinements++;
@@ -1204,6 +1208,59 @@ START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
     ck_assert_int_eq(tk_run_until(second, NULL, &err), TK_OK);
     ck_assert_uint_eq(tk_run_curve(second)->nvert, final);
     tk_run_free(&second);
+    tk_curve_free(&c);
+}
+END_TEST
+
+/* A loose start's coarse polygon follows the ropelength down: each time
+ * the ropelength has fallen by a quarter since the level's count was
+ * reckoned, and the count would fall by a quarter, it is resampled to 2.5
+ * vertices per unit of the ropelength reached (resolution 5), before the
+ * next step, feasible.  Lissajous 6_1 L(3,2,5): start ropelength 429, so
+ * 1073 coarse vertices, where the tight knot (56.7) needs 142. */
+START_TEST(a_loose_coarse_level_follows_the_ropelength)
+{
+    const int freq[3] = {3, 2, 5};
+    const double phase[3] = {0.7, 0.2, 0.0};
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_lissajous(freq, phase, 300, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 5;
+    o.escapes = 0;
+    o.max_steps = 100000; /* (the coarse level's share: half of it) */
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_uint_gt(tk_run_curve(run)->nvert, 1000);
+    while (tk_run_latest(run)->step < 2600)
+        ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
+    size_t nh = 0, resampled = 0;
+    const tk_step_report *h = tk_run_history(run, &nh);
+    /* the ropelength the count was last reckoned from: at first the
+     * start's (as autoscaled, step 0) */
+    ck_assert_int_eq(h[0].step, 0);
+    double reckoned = h[0].ropelength;
+    for (size_t i = 1; i < nh; i++) {
+        ck_assert_msg(h[i].thickness >= 1.0 - o.overstep_tolerance, "step %ld: thickness %.9f",
+                      h[i].step, h[i].thickness);
+        ck_assert_uint_le(h[i].vertices, h[i - 1].vertices);
+        double rope = h[i - 1].ropelength, want = ceil(2.5 * rope);
+        bool due = rope < 0.75 * reckoned && want < 0.75 * (double)h[i - 1].vertices;
+        if (h[i].vertices == h[i - 1].vertices) {
+            ck_assert_msg(!due, "step %ld: ropelength %.3f, reckoned from %.3f, %zu vertices",
+                          h[i].step, rope, reckoned, h[i].vertices);
+            continue;
+        }
+        printf("L(3,2,5) coarse: %zu -> %zu vertices at step %ld, ropelength %.3f\n",
+               h[i - 1].vertices, h[i].vertices, h[i].step, rope);
+        ck_assert_msg(due, "step %ld: not due", h[i].step);
+        ck_assert_uint_eq(h[i].vertices, (size_t)want);
+        reckoned = rope;
+        resampled++;
+    }
+    ck_assert_uint_ge(resampled, 2);
+    tk_run_free(&run);
     tk_curve_free(&c);
 }
 END_TEST
@@ -1340,6 +1397,7 @@ int main(void)
     tcase_add_test(tc, a_refined_tight_polygon_is_restored_without_rescaling);
     tcase_add_test(tc, a_loose_curve_is_kept_at_the_tube);
     tcase_add_test(tc, a_loose_start_keeps_its_final_count_through_escapes);
+    tcase_add_test(tc, a_loose_coarse_level_follows_the_ropelength);
     tcase_add_test(tc, unknot_and_unlink_are_handled);
     tcase_add_test(tc, hopf_link_tightens_towards_8_pi);
     tcase_add_test(tc, generated_hopf_link_tightens_to_8_pi);

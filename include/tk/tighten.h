@@ -112,7 +112,8 @@
       "to resolution x ropelength vertices again (0: never)")                                \
     X(coarse_to_fine, BOOL, true, 0, 1, "coarse",                                            \
       "with a resolution: start with half the vertices (a quarter, ... while 2.5 per unit "  \
-      "ropelength remain) and double them whenever the ropelength all but stops falling")    \
+      "ropelength remain), fewer each time the ropelength falls by a quarter, and double "   \
+      "them whenever it all but stops falling")                                              \
     X(escapes, INT, 8, 0, 1000, "escapes",                                                   \
       "most escapes: each time the ropelength all but stops falling on the final polygon "   \
       "(or has crawled there for a fifth of the budget) while a tenth of the budget is "     \
