@@ -126,9 +126,11 @@ struct tk_run {
         double start_ropelength; /* of the input, before any resampling, by its
                                     self-distance (the vertex counts' reference) */
         double final_ropelength; /* the final polygon's reference, fixed when the
-                                    run first reaches it (0: not yet) */
+                                    run first reaches it or first escapes
+                                    (0: not yet) */
         int coarse_level;    /* halvings of the vertex count still to undo */
-        int coarse_levels;   /* of them at the start */
+        int coarse_levels;   /* of them at the start (with the vertices
+                                option, at the final reference once fixed) */
         bool move_on;        /* refine before the next step */
         size_t resampled_from; /* history entries before the last resampling */
         double share_from;   /* budget spent when the current schedule began

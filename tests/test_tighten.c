@@ -1212,6 +1212,64 @@ START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
 }
 END_TEST
 
+/* With the vertices option a loose start can be too long for a coarse
+ * level (fewer than 2.5 vertices per unit of its ropelength at half the
+ * count), yet its escapes restart on a coarse polygon as those of a
+ * tighter start do: the first escape fixes the final polygon's reference
+ * at the ropelength reached, and the coarse levels are that ropelength's;
+ * resumed during an escape, the run reckons them the same.  T(2,3) from
+ * the round torus (ropelength 41 by its self-distance, the tight trefoil
+ * 32.7) at 4.8 vertices per unit of the start's. */
+START_TEST(a_loose_start_at_a_vertex_count_escapes_coarse)
+{
+    if (quick() && tkt_skip("a_loose_start_at_a_vertex_count_escapes_coarse", LONG_RUN))
+        return;
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 200, &c, NULL), TK_OK);
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, NULL), TK_OK);
+    double reckoned = 2.0 * m.length / m.shortest;
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.vertices = (size_t)floor(4.8 * reckoned);
+    o.escapes = 2;
+    o.max_steps = 20000;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, o.vertices); /* no coarse level */
+    while (tk_run_latest(run)->escapes < 2 && tk_run_latest(run)->step < o.max_steps)
+        ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
+    ck_assert_int_eq(tk_run_latest(run)->escapes, 2);
+    size_t nh = 0, coarse = (o.vertices + 1) / 2;
+    const tk_step_report *h = tk_run_history(run, &nh);
+    size_t escapes = 0;
+    double reference = 0.0;
+    for (size_t i = 1; i < nh; i++) {
+        if (h[i].escapes > h[i - 1].escapes) {
+            ck_assert_uint_eq(h[i].vertices, coarse);
+            if (escapes++ == 0)
+                reference = h[i - 1].ropelength;
+        } else {
+            ck_assert_msg(h[i].vertices == h[i - 1].vertices || h[i].vertices == o.vertices,
+                          "step %ld: %zu vertices", h[i].step, h[i].vertices);
+        }
+    }
+    printf("T(2,3) at %zu vertices (start ropelength %.2f): escapes on %zu, the final "
+           "reference %.4f\n",
+           o.vertices, reckoned, coarse, reference);
+    ck_assert_double_le(reference, reckoned * 4.8 / 5.0); /* 2.5 a unit at half the count */
+    tk_resume at;
+    tk_run *second = interrupted(run, tk_run_latest(run)->step + 5, &at);
+    ck_assert(at.final_ropelength == reference);
+    ck_assert_int_eq(at.coarse_level, 1);
+    ck_assert_int_eq(tk_run_until(second, NULL, &err), TK_OK);
+    ck_assert_uint_eq(tk_run_curve(second)->nvert, o.vertices);
+    tk_run_free(&second);
+    tk_curve_free(&c);
+}
+END_TEST
+
 /* A loose start's coarse polygon follows the ropelength down: each time
  * the ropelength has fallen by a quarter since the level's count was
  * reckoned, and the count would fall by a quarter, it is resampled to 2.5
@@ -1398,6 +1456,7 @@ int main(void)
     tcase_add_test(tc, a_loose_curve_is_kept_at_the_tube);
     tcase_add_test(tc, a_loose_start_keeps_its_final_count_through_escapes);
     tcase_add_test(tc, a_loose_coarse_level_follows_the_ropelength);
+    tcase_add_test(tc, a_loose_start_at_a_vertex_count_escapes_coarse);
     tcase_add_test(tc, unknot_and_unlink_are_handled);
     tcase_add_test(tc, hopf_link_tightens_towards_8_pi);
     tcase_add_test(tc, generated_hopf_link_tightens_to_8_pi);
