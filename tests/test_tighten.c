@@ -1218,7 +1218,7 @@ END_TEST
  * tighter start do: the first escape fixes the final polygon's reference
  * at the ropelength reached, and the coarse levels are that ropelength's;
  * resumed during an escape, the run reckons them the same.  T(2,3) from
- * the round torus (ropelength 41 by its self-distance, the tight trefoil
+ * the round torus (ropelength 38.3 by its self-distance, the tight trefoil
  * 32.7) at 4.8 vertices per unit of the start's. */
 START_TEST(a_loose_start_at_a_vertex_count_escapes_coarse)
 {
