@@ -34,7 +34,8 @@
 #include "tk/thickness.h"
 
 /* Converged: the ropelength fell by less than ESCAPE_CHANGE (relative)
- * over ESCAPE_WINDOW steps of the final polygon. */
+ * over ESCAPE_WINDOW steps of the final polygon (counted for its edges,
+ * tk_schedule_window). */
 #define ESCAPE_WINDOW 300
 #define ESCAPE_CHANGE 2e-5
 /* The deformation: ESCAPE_MODES Fourier modes per component, mode k with
@@ -72,7 +73,8 @@ bool tk_escape_converged(const tk_run *r)
 {
     double fall;
     if (!tk_schedule_final(r) ||
-        !tk_history_fall(r, r->schedule.resampled_from, ESCAPE_WINDOW, &fall))
+        !tk_history_fall(r, r->schedule.resampled_from, tk_schedule_window(r, ESCAPE_WINDOW),
+                         &fall))
         return false;
     if (fall < ESCAPE_CHANGE)
         return true;

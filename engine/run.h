@@ -366,6 +366,9 @@ bool tk_schedule_move_on(tk_run *r);
 bool tk_schedule_share_spent(const tk_run *r);
 bool tk_schedule_final(const tk_run *r);
 size_t tk_schedule_final_count(const tk_run *r);
+/* A window of `steps` steps at resolution 5, counted for the run's
+ * polygon: as many more steps as its mean edge is shorter. */
+size_t tk_schedule_window(const tk_run *r, size_t steps);
 double tk_tolerance_active(const tk_run *r);
 double tk_tolerance_overstep(const tk_run *r);
 double tk_tolerance_correction(const tk_run *r);

@@ -15,6 +15,17 @@
 #define POLISH_CHANGE 1e-4
 #define POLISH_FACTOR (1.0 / 3.0)
 #define POLISH_LEVELS 4
+/* The windows of steps that judge whether the ropelength has stopped
+ * falling (the polish watch here, convergence for an escape) are counted
+ * for a polygon whose mean edge is WINDOW_EDGE diameters (resolution 5)
+ * and grow as the edges shorten: no vertex moves more than a quarter of
+ * the shortest edge a step (stepping.c), so the same motion of the curve
+ * takes as many more steps as the edges are shorter.  Counted in steps
+ * alone, the trefoil at 4,800 vertices left its 1,200- and 2,400-vertex
+ * levels after 10 and 5 s, reached 4,800 at 32.7545 and crawled there
+ * (1,066 steps of 1.3 s in 1,400 s, 32.7539 at the end), while a run
+ * kept at 2,400 was at 32.7434 by 600 s. */
+#define WINDOW_EDGE 0.1
 /* On a fine polygon the active tolerance is at most ACTIVE_PER_EDGE2
  * times the squared mean edge (in diameters).  Next to a contact of
  * nearly parallel strands the k-th pair along them is farther by about
@@ -73,15 +84,27 @@ static double polish_scale(const tk_run *r)
     return pow(POLISH_FACTOR, r->schedule.polish_level);
 }
 
-double tk_tolerance_active(const tk_run *r)
+/* The mean edge of the run's polygon over the diameter (0 when unknown). */
+static double mean_edge(const tk_run *r)
 {
-    double active = r->opt.active_tolerance;
     size_t edges = tk_curve_edge_count(r->shared.curve);
     double rope = r->life.latest.ropelength;
-    if (edges > 0 && rope > 0.0 && isfinite(rope)) {
-        double h = rope / (2.0 * (double)edges); /* mean edge over the diameter */
+    return edges > 0 && rope > 0.0 && isfinite(rope) ? rope / (2.0 * (double)edges) : 0.0;
+}
+
+size_t tk_schedule_window(const tk_run *r, size_t steps)
+{
+    double h = mean_edge(r);
+    if (!(h > 0.0) || h >= WINDOW_EDGE)
+        return steps;
+    return (size_t)lround((double)steps * WINDOW_EDGE / h);
+}
+
+double tk_tolerance_active(const tk_run *r)
+{
+    double active = r->opt.active_tolerance, h = mean_edge(r);
+    if (h > 0.0)
         active = fmin(active, ACTIVE_PER_EDGE2 * h * h);
-    }
     return active * polish_scale(r);
 }
 
@@ -562,7 +585,8 @@ void tk_schedule_watch(tk_run *r)
 {
     double fall;
     if (r->schedule.polish_level < POLISH_LEVELS &&
-        tk_history_fall(r, r->schedule.polish_from, POLISH_WINDOW, &fall) &&
+        tk_history_fall(r, r->schedule.polish_from, tk_schedule_window(r, POLISH_WINDOW),
+                        &fall) &&
         fall < POLISH_CHANGE * polish_scale(r) && !tk_schedule_move_on(r)) {
         r->schedule.polish_level++;
         r->schedule.polish_from = r->life.nhistory;

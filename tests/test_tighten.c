@@ -1323,6 +1323,83 @@ START_TEST(a_loose_coarse_level_follows_the_ropelength)
 }
 END_TEST
 
+/* The fall of tk_history_fall (run.h), recomputed: the least ropelength
+ * of the last `window` reports up to (not including) report `n` against
+ * the least of the `window` before them (fewer when the level is
+ * younger), relative; NAN before `from` + `window` reports. */
+static double fall_over(const tk_step_report *h, size_t from, size_t n, size_t window)
+{
+    if (n <= from + window)
+        return NAN;
+    size_t split = n - window, first = split > from + window ? split - window : from;
+    double before = INFINITY, recent = INFINITY;
+    for (size_t k = first; k < split; k++)
+        before = fmin(before, h[k].ropelength);
+    for (size_t k = split; k < n; k++)
+        recent = fmin(recent, h[k].ropelength);
+    return (before - recent) / recent;
+}
+
+/* A coarse level moves on when its ropelength fell by less than 1e-4 over
+ * 200 steps counted for a mean edge of a tenth of the diameter: on a
+ * polygon with shorter edges, as many more steps as they are shorter
+ * (each step moves a vertex at most a quarter of the shortest edge).  A
+ * trefoil at 600 vertices from the round torus (start ropelength 38.3,
+ * tight 32.7: a mean edge of 0.055 diameters on the 300-vertex level)
+ * goes through coarse levels of 150 and 300 vertices; with a step budget
+ * too large for any level's share to end it, each level ends exactly
+ * where the rule first holds. */
+START_TEST(a_fine_coarse_level_waits_as_many_more_steps)
+{
+    if (quick() && tkt_skip("a_fine_coarse_level_waits_as_many_more_steps", LONG_RUN))
+        return;
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 200, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.vertices = 600;
+    o.escapes = 0;
+    o.max_steps = 1000000;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, 150);
+    while (tk_run_curve(run)->nvert < o.vertices && tk_run_latest(run)->step < 20000)
+        ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, o.vertices);
+    size_t nh = 0, from = 0, levels = 0;
+    const tk_step_report *h = tk_run_history(run, &nh);
+    double most = 1.0;
+    /* The step of report i was judged after its motion, on the reports
+     * before it (the mean edge: report i - 1's ropelength over report i's
+     * edges); a move-on shows as report i + 1's count.  A level's window
+     * starts at its first report. */
+    for (size_t i = 1; i + 1 < nh; i++) {
+        double edge = h[i - 1].ropelength / (2.0 * (double)h[i].vertices);
+        double scale = fmax(1.0, 0.1 / edge);
+        size_t window = edge >= 0.1 ? 200 : (size_t)lround(200.0 * 0.1 / edge);
+        double fall = fall_over(h, from, i, window);
+        bool due = fall < 1e-4; /* false while NAN */
+        bool moved = h[i + 1].vertices != h[i].vertices;
+        ck_assert_msg(due == moved, "step %ld on %zu vertices: window %zu, fall %.3g, %s",
+                      h[i].step, h[i].vertices, window, fall, moved ? "moved on" : "stayed");
+        if (moved) {
+            printf("T(2,3) at 600: the %zu-vertex level moved on at step %ld after %zu steps "
+                   "(window %zu), ropelength %.5f\n",
+                   h[i].vertices, h[i].step, i + 1 - from, window, h[i].ropelength);
+            ck_assert_uint_eq(h[i + 1].vertices, 2 * h[i].vertices);
+            most = fmax(most, scale);
+            from = i + 1;
+            levels++;
+        }
+    }
+    ck_assert_uint_eq(levels, 2);
+    ck_assert_double_ge(most, 1.5); /* the rule in steps alone would differ */
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 /* Resumed during an escape, a run keeps its best curve, its tries and
  * its random stream: it ends no worse than the best it had. */
 START_TEST(a_resumed_run_keeps_its_escapes)
@@ -1457,6 +1534,7 @@ int main(void)
     tcase_add_test(tc, a_loose_start_keeps_its_final_count_through_escapes);
     tcase_add_test(tc, a_loose_coarse_level_follows_the_ropelength);
     tcase_add_test(tc, a_loose_start_at_a_vertex_count_escapes_coarse);
+    tcase_add_test(tc, a_fine_coarse_level_waits_as_many_more_steps);
     tcase_add_test(tc, unknot_and_unlink_are_handled);
     tcase_add_test(tc, hopf_link_tightens_towards_8_pi);
     tcase_add_test(tc, generated_hopf_link_tightens_to_8_pi);
