@@ -84,11 +84,19 @@ static double polish_scale(const tk_run *r)
     return pow(POLISH_FACTOR, r->schedule.polish_level);
 }
 
-/* The mean edge of the run's polygon over the diameter (0 when unknown). */
+/* The mean edge of the run's polygon over the diameter (0 when unknown):
+ * half the ropelength of the last step's figures per edge, or, while a run
+ * is set up and has none yet, its curve's length over the diameter per edge.
+ * Without that fallback a new or resumed run on a fine polygon corrected
+ * its start and found its first active set with the options' tolerance
+ * instead of 0.3 h^2: a tight trefoil on 2,400 vertices had 48,585 struts
+ * active at step 0 (about 4,000 a step later) and took 321 s to set up. */
 static double mean_edge(const tk_run *r)
 {
     size_t edges = tk_curve_edge_count(r->shared.curve);
     double rope = r->life.latest.ropelength;
+    if (!(rope > 0.0 && isfinite(rope)))
+        rope = 2.0 * tk_curve_length(r->shared.curve) / r->tau;
     return edges > 0 && rope > 0.0 && isfinite(rope) ? rope / (2.0 * (double)edges) : 0.0;
 }
 

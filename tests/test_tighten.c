@@ -408,8 +408,9 @@ END_TEST
 START_TEST(recovery_restores_thousands_of_contacts_without_rescaling)
 {
     /* The round Hopf link: every vertex of each ring is at distance 1 from
-     * the other ring, thousands of struts at 300 vertices a ring (a
-     * vertex is near several edges).  Shrunk by
+     * the other ring, over a thousand struts at 300 vertices a ring (a
+     * vertex is near several edges; 1,292 with the active tolerance of
+     * these edges, 0.3 h^2 = 1.3e-4).  Shrunk by
      * 1e-3 about the origin, every one of them is violated by 1e-3 of the
      * diameter; the run's error recovery (a start may overstep by up to
      * its overstep tolerance, here 2e-3) must restore the thickness by
@@ -430,13 +431,13 @@ START_TEST(recovery_restores_thousands_of_contacts_without_rescaling)
     ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
     const tk_step_report *first = tk_run_latest(run);
     printf("recovery at %zu struts: %d corrections\n", first->struts, first->corrections);
-    ck_assert_uint_ge(first->struts, 2000);
+    ck_assert_uint_ge(first->struts, 1000);
     tk_run_timing t;
     tk_run_timing_get(run, &t);
     ck_assert_int_eq(t.rescales, 0);
     const tk_curve *d = tk_run_curve(run);
     ck_assert_int_eq(tk_thickness_measure(d, NULL, &m, NULL), TK_OK);
-    /* the correction tolerance: a tenth of the active one, 3e-4 */
+    /* the correction tolerance: a tenth of the overstep one, at most 3e-5 */
     ck_assert_msg(m.thickness >= 1.0 - 3e-5, "thickness %.9f", m.thickness);
     double moved = 0.0;
     for (size_t i = 0; i < 3 * d->nvert; i += 3) {
@@ -446,7 +447,7 @@ START_TEST(recovery_restores_thousands_of_contacts_without_rescaling)
     }
     /* what it costs: a rescaling to the diameter would lengthen the
      * curve by 1e-3 and lose every contact (all are 1e-3 off, beyond the
-     * active tolerance 3e-4); the Newton steps keep the contacts (counted
+     * active tolerance, at most 3e-4); the Newton steps keep the contacts (counted
      * above, after the recovery) and deform the curve smoothly (the
      * vertices at the other ring's centre, near all of it, move most) at
      * a cost of the same order (0.14%) */
@@ -460,6 +461,55 @@ START_TEST(recovery_restores_thousands_of_contacts_without_rescaling)
     ck_assert_int_eq(why, TK_STOP_STEPS);
     tk_run_timing_get(run, &t);
     ck_assert_int_eq(t.rescales, 0);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
+START_TEST(a_fine_start_is_set_up_with_the_tolerance_of_its_edges)
+{
+    /* On a fine polygon the active tolerance is 0.3 h^2 (h the mean edge
+     * in diameters), below the options' 3e-4.  A run being set up has no
+     * step figures yet to reckon h from; its first active set must still
+     * be taken with 0.3 h^2.  (With 3e-4 a tight trefoil resampled to
+     * 2,400 vertices had 48,585 struts active at step 0, about 9,000 a
+     * step later, and took 321 s to set up.)  Here: T(2,3) on 2,000
+     * vertices, scaled so that its thickness is just the diameter. */
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 2000, &c, NULL), TK_OK);
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, NULL), TK_OK);
+    tk_curve_scale(c, (1.0 + 1e-9) / m.thickness);
+    tk_options o = TK_OPTIONS_INIT;
+    o.max_steps = 1;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    const tk_curve *d = tk_run_curve(run);
+    double h = tk_curve_length(d) / (double)tk_curve_edge_count(d);
+    double tolerance = 0.3 * h * h;
+    ck_assert_msg(tolerance < 0.2 * o.active_tolerance, "h %g: not a fine polygon", h);
+    size_t n = 0;
+    const tk_strut *struts = tk_run_struts(run, &n);
+    double longest = 0.0;
+    for (size_t j = 0; j < n; j++)
+        longest = fmax(longest, struts[j].length);
+    /* the options' tolerance would have taken more pairs */
+    tk_strut_finder *f = NULL;
+    tk_strut_list wide = {0};
+    ck_assert_int_eq(tk_strut_finder_new(d, &f, NULL), TK_OK);
+    ck_assert_int_eq(tk_strut_finder_find_pairs(f, d, TK_ARC_ADMISSIBLE, 1.0,
+                                                1.0 + o.active_tolerance, &wide, NULL),
+                     TK_OK);
+    printf("set up on %zu vertices: %zu struts, the longest 1 + %.3g (0.3 h^2 = %.3g); "
+           "%zu pairs within 1 + %g\n",
+           d->nvert, n, longest - 1.0, tolerance, wide.count, o.active_tolerance);
+    ck_assert_uint_gt(n, 0);
+    ck_assert_msg(longest <= 1.0 + tolerance * (1.0 + 1e-6), "a strut of 1 + %.3g at step 0",
+                  longest - 1.0);
+    ck_assert_uint_gt(wide.count, n);
+    tk_strut_list_free(&wide);
+    tk_strut_finder_free(&f);
     tk_run_free(&run);
     tk_curve_free(&c);
 }
@@ -1529,6 +1579,7 @@ int main(void)
     tcase_add_test(tc, parallel_runs_equal_serial_runs);
     tcase_add_test(tc, round_hopf_start_with_continuum_of_contacts);
     tcase_add_test(tc, recovery_restores_thousands_of_contacts_without_rescaling);
+    tcase_add_test(tc, a_fine_start_is_set_up_with_the_tolerance_of_its_edges);
     tcase_add_test(tc, a_refined_tight_polygon_is_restored_without_rescaling);
     tcase_add_test(tc, a_loose_curve_is_kept_at_the_tube);
     tcase_add_test(tc, a_loose_start_keeps_its_final_count_through_escapes);
