@@ -147,7 +147,7 @@ int main(int argc, char **argv)
             double t1 = now();
             double warm = (t1 - t0) / 2.0;
             double delta;
-            rc |= tk_nnls_min_norm(s, A, r, 0.0, du, &delta, &err);
+            rc |= tk_nnls_min_norm(s, A, r, 0.0, NULL, du, &delta, &err);
             double mn = now() - t1;
             if (rc != TK_OK)
                 printf("  (status %d: %s)\n", rc, err.message);

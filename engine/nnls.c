@@ -1991,8 +1991,74 @@ static bool primal_is_smaller(const cholmod_sparse *A, const int *F, size_t nf, 
     return primal < dual;
 }
 
+/* The damped step in the metric M: (P P' + delta M) du = P c, P (m x nf)
+ * the scaled columns and c their targets, solved with a factorisation of
+ * the sum (formed: M is not a multiple of I, so CHOLMOD's beta cannot
+ * add it) and two steps of refinement whose residual comes from P and M
+ * themselves.  w holds nf entries and res m. */
+static int metric_solve(tk_nnls *s, const cholmod_sparse *P, const cholmod_sparse *M,
+                        double delta, const double *c, double *du, double *w, double *res,
+                        tk_error *err)
+{
+    size_t m = P->nrow;
+    int rc = TK_OK;
+    double one[2] = {1.0, 0.0}, weight[2] = {delta, 0.0};
+    cholmod_sparse *ppt = cholmod_aat((cholmod_sparse *)P, NULL, 0, 1, &s->cc);
+    cholmod_sparse *sum =
+        ppt ? cholmod_add(ppt, (cholmod_sparse *)M, one, weight, 1, 1, &s->cc) : NULL;
+    cholmod_sparse *upper = sum ? cholmod_copy(sum, 1, 1, &s->cc) : NULL;
+    cholmod_factor *L = upper ? cholmod_analyze(upper, &s->cc) : NULL;
+    if (!L || !cholmod_factorize(upper, L, &s->cc) || s->cc.status < CHOLMOD_OK) {
+        rc = cholmod_failure(s, "factorize", err);
+        goto done;
+    }
+    if (s->cc.status == CHOLMOD_NOT_POSDEF || !(factor_rcond(L) > 0.0)) {
+        rc = tk_error_set(err, TK_ENUMERIC, "nnls: the damped step's matrix (order %zu) is "
+                          "not positive definite", m);
+        goto done;
+    }
+    cholmod_dense X;
+    memset(&X, 0, sizeof X);
+    X.nrow = X.nzmax = X.d = m;
+    X.ncol = 1;
+    X.x = du;
+    X.xtype = CHOLMOD_REAL;
+    X.dtype = CHOLMOD_DOUBLE;
+    const double *sol;
+    t_times(P, c, res);
+    memset(du, 0, m * sizeof *du);
+    for (int step = 0; step < 3 && rc == TK_OK; step++) {
+        if (step > 0) {
+            /* res = P c - P P' du - delta M du */
+            cholmod_dense R = X;
+            R.x = res;
+            t_times(P, c, res);
+            t_transpose_times(P, du, w);
+            for (size_t k = 0; k < P->ncol; k++)
+                w[k] = -w[k];
+            double minus_delta[2] = {-delta, 0.0};
+            cholmod_sdmult((cholmod_sparse *)M, 0, minus_delta, one, &X, &R, &s->cc);
+            const int *Pp = P->p, *Pi = P->i;
+            const double *Px = P->x;
+            for (size_t k = 0; k < P->ncol; k++)
+                for (int e = Pp[k]; e < Pp[k + 1]; e++)
+                    res[Pi[e]] += Px[e] * w[k];
+        }
+        if ((rc = factor_solve(s, L, res, m, &sol, err)) == TK_OK)
+            for (size_t i = 0; i < m; i++)
+                du[i] += sol[i];
+    }
+done:
+    cholmod_free_factor(&L, &s->cc);
+    cholmod_free_sparse(&upper, &s->cc);
+    cholmod_free_sparse(&sum, &s->cc);
+    cholmod_free_sparse(&ppt, &s->cc);
+    return rc;
+}
+
 int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, double delta_min,
-                     double *du, double *delta_used, tk_error *err)
+                     const cholmod_sparse *metric, double *du, double *delta_used,
+                     tk_error *err)
 {
     int rc = TK_OK;
     int *F = NULL, *next = NULL;
@@ -2013,6 +2079,12 @@ int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, doubl
     if (!(delta_min >= 0.0 && delta_min <= NNLS_DELTA_CAP))
         return tk_error_set(err, TK_EINVAL, "nnls: damping %g outside [0, %g]", delta_min,
                             NNLS_DELTA_CAP);
+    if (metric && !(delta_min > 0.0 && metric->nrow == m && metric->ncol == m &&
+                    metric->stype == 0 && metric->xtype == CHOLMOD_REAL))
+        return tk_error_set(err, TK_EINVAL,
+                            "nnls: a metric needs a positive damping and a real %zu x %zu "
+                            "matrix with both triangles stored",
+                            m, m);
     for (size_t k = 0; k < m; k++)
         du[k] = 0.0;
     if (n == 0 || m == 0)
@@ -2046,8 +2118,9 @@ int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, doubl
     }
     if (nf == 0)
         goto done;
-    /* delta = 0 needs the dual form: P P' is singular below full rank */
-    bool primal = delta_min > 0.0 && primal_is_smaller(A, F, nf, next);
+    /* delta = 0 needs the dual form: P P' is singular below full rank; a
+     * metric the primal one (the dual would need its inverse) */
+    bool primal = metric || (delta_min > 0.0 && primal_is_smaller(A, F, nf, next));
     T = primal ? cholmod_allocate_sparse(m, n, matrix_nnz(A), 1, 1, 0, CHOLMOD_REAL, &s->cc)
                : cholmod_allocate_sparse(n, m, matrix_nnz(A), 1, 1, 0, CHOLMOD_REAL, &s->cc);
     if (!T) {
@@ -2058,6 +2131,12 @@ int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, doubl
         build_scaled(A, F, nf, inv_norm, T);
     else
         build_transpose(A, F, nf, inv_norm, T, next);
+    if (metric) {
+        if ((rc = metric_solve(s, T, metric, delta_min, c, du, z, res, err)) == TK_OK &&
+            delta_used)
+            *delta_used = delta_min;
+        goto done;
+    }
     nnls_factor f = {NULL, 0.0, 1.0, 0, false};
     if ((rc = factor_normal(s, T, NULL, NULL, 0, delta_min, true, NNLS_DEFAULT_RCOND_FLOOR, &f,
                             err)) != TK_OK)

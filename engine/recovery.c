@@ -213,17 +213,93 @@ static int line_search(tk_run *r, double *worst, int *halvings, bool *improved, 
     return rc;
 }
 
-/* One Newton step with the given damping on the violated constraints
- * (the columns of a, their deficits in recovery.rhs), through
- * line_search. */
-static int damped_step(tk_run *r, const cholmod_sparse *a, double damping, double *worst,
-                       int *halvings, bool *improved, tk_error *err)
+/* The Newton steps' metric.  On a fine polygon a vertex's radius of
+ * curvature is stiff to any motion that is not smooth: moving it by d
+ * across edges of length e that turn by theta changes the radius by about
+ * 2 d / (e theta) of itself.  The minimum-norm step on the violated
+ * constraints is rough at the scale of an edge (it moves only the
+ * vertices of violated struts), and on a tight trefoil of 4,800 vertices
+ * resampled to 2,400 (struts violated by up to 4.9e-6, two radii by
+ * 9.4e-6) every such step broke the curvature bound at some vertex by 13%
+ * to 97%, however damped, until the curve had to be rescaled.  So the
+ * damping measures a step by its bending as well as its length:
+ *     du' M du = |du|^2 + l^4 |du''|^2,
+ * du'' the second differences along each component over its mean edge
+ * squared.  A motion a sin(s / l) changes a strut by up to a, a/tau of
+ * its bound, and a radius by about a r^2 / l^2, a r_min / l^2 of its
+ * bound: l^2 = tau r_min makes the two alike, so that a step which mends
+ * the struts bends the curve by as little.  On that curve, after the
+ * plain Newton and inequality steps, two such steps restore it (3.7 s
+ * in all, the length up 2.6e-6; it used to be scaled up by 1 + 9.3e-6).
+ * Alone, without the inequality steps before them, they restore it in
+ * two (0.5 s). */
+static int metric_build(const tk_run *r, cholmod_common *cc, cholmod_sparse **out,
+                        tk_error *err)
+{
+    const tk_curve *c = r->shared.curve;
+    size_t m = 3 * c->nvert;
+    double l2 = r->tau * r->min_radius;
+    *out = NULL;
+    cholmod_triplet *t = cholmod_allocate_triplet(m, m, 9 * m, 0, CHOLMOD_REAL, cc);
+    if (!t)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for a recovery step");
+    int *ti = t->i, *tj = t->j;
+    double *tx = t->x;
+    size_t rows = 0;
+    for (size_t comp = 0; comp < c->ncomp; comp++) {
+        size_t ne = tk_curve_comp_edges(c, comp);
+        double edge = ne ? tk_curve_comp_length(c, comp) / (double)ne : 0.0;
+        if (!(edge > 0.0))
+            continue;
+        /* row (as t's column) v of the second difference, in units of
+         * l^2: (x_prev - 2 x_v + x_next) l^2 / e^2; a fixed vertex does
+         * not move, so its column is left out */
+        double w = l2 / (edge * edge);
+        size_t first = c->offset[comp], count = tk_curve_comp_vertices(c, comp);
+        for (size_t v = first; v < first + count; v++) {
+            size_t at[3], prev, next;
+            if (!tk_curve_vertex_neighbours(c, v, &prev, &next))
+                continue;
+            at[0] = prev;
+            at[1] = v;
+            at[2] = next;
+            for (int x = 0; x < 3; x++, rows++)
+                for (int k = 0; k < 3; k++) {
+                    if (r->shared.fixed[at[k]])
+                        continue;
+                    ti[t->nnz] = (int)(3 * at[k] + (size_t)x);
+                    tj[t->nnz] = (int)rows;
+                    tx[t->nnz++] = k == 1 ? -2.0 * w : w;
+                }
+        }
+    }
+    t->ncol = rows;
+    int rc = TK_OK;
+    double one[2] = {1.0, 0.0};
+    cholmod_sparse *st = cholmod_triplet_to_sparse(t, t->nnz, cc);
+    cholmod_sparse *sst = st ? cholmod_aat(st, NULL, 0, 1, cc) : NULL;
+    cholmod_sparse *eye = sst ? cholmod_speye(m, m, CHOLMOD_REAL, cc) : NULL;
+    if (!eye || !(*out = cholmod_add(sst, eye, one, one, 1, 1, cc)))
+        rc = tk_error_set(err, TK_ENOMEM, "out of memory for a recovery step");
+    cholmod_free_sparse(&eye, cc);
+    cholmod_free_sparse(&sst, cc);
+    cholmod_free_sparse(&st, cc);
+    cholmod_free_triplet(&t, cc);
+    return rc;
+}
+
+/* One Newton step with the given damping in the metric (metric_build) on
+ * the violated constraints (the columns of a, their deficits in
+ * recovery.rhs), through line_search. */
+static int damped_step(tk_run *r, const cholmod_sparse *a, const cholmod_sparse *metric,
+                       double damping, double *worst, int *halvings, bool *improved,
+                       tk_error *err)
 {
     double delta = 0.0;
     double t0 = tk_clock();
     *improved = false;
-    int rc = tk_nnls_min_norm(r->shared.nnls, a, r->recovery.rhs, damping, r->recovery.du, &delta,
-                              err);
+    int rc = tk_nnls_min_norm(r->shared.nnls, a, r->recovery.rhs, damping, metric,
+                              r->recovery.du, &delta, err);
     r->recovery.nnls_seconds += tk_clock() - t0;
     return rc ? rc : line_search(r, worst, halvings, improved, err);
 }
@@ -256,8 +332,8 @@ static int damped_step(tk_run *r, const cholmod_sparse *a, double damping, doubl
  * the thousands of struts' vertices bends further (a tight trefoil of
  * 4,800 vertices resampled to 2,400: two kinks 9.4e-6 over, the whole
  * curve's struts up to 4.9e-6), each step lowered it by 0.1% in 3 to 5 s
- * (9.37e-6 to 9.30e-6 in ten steps, 36 s), and the rescale that followed
- * was needed anyway. */
+ * (9.37e-6 to 9.30e-6 in ten steps, 36 s); the steps that follow
+ * (metric_build) restore it. */
 #define INEQUALITY_CRAWL 0.01
 
 /* One such step over the active set at the run's curve, through
@@ -331,14 +407,67 @@ static int inequality_step(tk_run *r, double *worst, bool *improved, tk_error *e
     return rc;
 }
 
-/* Newton steps du solving A_V^T du = -R with minimum norm (damped), R the
- * violations of the violated constraints V among the active ones, until
- * every violation is below the correction tolerance.  Each step is damped
- * until the worst violation falls (near-dependent constraints can make the
- * regularised solution long).  Where they can no longer lower it,
- * inequality steps (inequality_step) take over (see INEQUALITY_STEPS);
- * rescaling about the centroid is the last resort, for leftovers up to
- * rescale_up_to only. */
+/* Newton steps du solving A_V^T du = -R with minimum norm (damped) in
+ * the metric (NULL: |du|), R the violations of the violated constraints V
+ * among the active ones, until every violation is below the correction
+ * tolerance or `most` steps have been taken (counted in *iterations).
+ * Each step is damped until the worst violation falls (near-dependent
+ * constraints can make the regularised solution long); they end where no
+ * damping gives a step that lowers it. */
+static int newton_steps(tk_run *r, int most, const cholmod_sparse *metric, double *worst,
+                        int *iterations, tk_error *err)
+{
+    tk_curve *c = r->shared.curve;
+    tk_constraints *set = &r->recovery.violated;
+    double damping = RECOVERY_DAMPING;
+    int rc = TK_OK;
+    for (int it = 0; !rc && *worst > tk_tolerance_correction(r) && it < most; it++) {
+        rc = tk_active_find(r, c, set, err);
+        if (!rc)
+            rc = tk_grow_doubles(&r->recovery.rhs, &r->recovery.rhs_capacity,
+                                 set->struts.count + set->nkinks, err);
+        if (rc || set->struts.count + set->nkinks == 0 || keep_violated(r) == 0)
+            break;
+        cholmod_sparse *a = NULL;
+        if ((rc = tk_active_matrix(r, c, set, &a, err)) != TK_OK)
+            break;
+        bool improved = false;
+        int halvings = 0;
+        for (;;) {
+            rc = damped_step(r, a, metric, damping, worst, &halvings, &improved, err);
+            if (rc || improved || !(damping < RECOVERY_DAMPING_MOST))
+                break;
+            /* no cut of the step helps: solved again, damped more */
+            damping = fmin(damping * RECOVERY_DAMPING_STEP * RECOVERY_DAMPING_STEP,
+                           RECOVERY_DAMPING_MOST);
+        }
+        cholmod_free_sparse(&a, tk_nnls_common(r->shared.nnls));
+        if (rc)
+            break;
+        (*iterations)++;
+        if (!improved)
+            break;
+        /* Levenberg-Marquardt: a step taken whole lowers the damping, one
+         * cut short raises it */
+        if (halvings == 0)
+            damping = fmax(damping / RECOVERY_DAMPING_STEP, RECOVERY_DAMPING);
+        else if (halvings >= RECOVERY_HALVINGS_KEPT)
+            damping = fmin(damping * RECOVERY_DAMPING_STEP, RECOVERY_DAMPING_MOST);
+    }
+    return rc;
+}
+
+/* Newton steps (newton_steps) until every violation is below the
+ * correction tolerance.  Where they can no longer lower the worst,
+ * inequality steps (inequality_step) take over (see INEQUALITY_STEPS),
+ * and where those crawl, Newton steps measured by their bending too
+ * (metric_build).  Rescaling about the centroid is the last resort, for
+ * leftovers up to rescale_up_to only.  The stages go in that order
+ * because each leaves the trajectories the earlier ones serve as they
+ * were: the figure-eight refinement of tests/test_tighten, which the
+ * inequality steps restore with its length up 0.013%, came out 0.1%
+ * shorter by the bending metric's steps (they spread each repair over
+ * some l / e edges). */
 static int correct(tk_run *r, int most, double rescale_up_to, int *iterations, tk_error *err);
 
 int tk_recovery_correct(tk_run *r, int most, double rescale_up_to, int *iterations,
@@ -352,49 +481,12 @@ int tk_recovery_correct(tk_run *r, int most, double rescale_up_to, int *iteratio
 
 static int correct(tk_run *r, int most, double rescale_up_to, int *iterations, tk_error *err)
 {
-    tk_curve *c = r->shared.curve;
-    tk_strut_finder *finder = r->shared.finder;
-    tk_constraints *set = &r->recovery.violated;
     *iterations = 0;
-    tk_strut_finder_refit(finder, c);
-    double worst, damping = RECOVERY_DAMPING;
-    int rc = tk_recovery_violation(r, c, &worst, err);
-    for (int it = 0; !rc && worst > tk_tolerance_correction(r) && it < most; it++) {
-        rc = tk_active_find(r, c, set, err);
-        if (!rc)
-            rc = tk_grow_doubles(&r->recovery.rhs, &r->recovery.rhs_capacity,
-                                 set->struts.count + set->nkinks, err);
-        if (rc)
-            return rc;
-        if (set->struts.count + set->nkinks == 0 || keep_violated(r) == 0)
-            break;
-        cholmod_sparse *a = NULL;
-        rc = tk_active_matrix(r, c, set, &a, err);
-        if (rc)
-            return rc;
-        bool improved = false;
-        int halvings = 0;
-        for (;;) {
-            rc = damped_step(r, a, damping, &worst, &halvings, &improved, err);
-            if (rc || improved || !(damping < RECOVERY_DAMPING_MOST))
-                break;
-            /* no cut of the step helps: solved again, damped more */
-            damping = fmin(damping * RECOVERY_DAMPING_STEP * RECOVERY_DAMPING_STEP,
-                           RECOVERY_DAMPING_MOST);
-        }
-        cholmod_free_sparse(&a, tk_nnls_common(r->shared.nnls));
-        if (rc)
-            return rc;
-        (*iterations)++;
-        if (!improved)
-            break;
-        /* Levenberg-Marquardt: a step taken whole lowers the damping, one
-         * cut short raises it */
-        if (halvings == 0)
-            damping = fmax(damping / RECOVERY_DAMPING_STEP, RECOVERY_DAMPING);
-        else if (halvings >= RECOVERY_HALVINGS_KEPT)
-            damping = fmin(damping * RECOVERY_DAMPING_STEP, RECOVERY_DAMPING_MOST);
-    }
+    tk_strut_finder_refit(r->shared.finder, r->shared.curve);
+    double worst;
+    int rc = tk_recovery_violation(r, r->shared.curve, &worst, err);
+    if (!rc)
+        rc = newton_steps(r, most, NULL, &worst, iterations, err);
     int inequality_most = most / 10 > INEQUALITY_STEPS ? most / 10 : INEQUALITY_STEPS;
     for (int it = 0; !rc && worst > tk_tolerance_correction(r) && it < inequality_most; it++) {
         bool improved = false;
@@ -403,6 +495,13 @@ static int correct(tk_run *r, int most, double rescale_up_to, int *iterations, t
         (*iterations)++;
         if (!improved || worst > (1.0 - INEQUALITY_CRAWL) * was)
             break;
+    }
+    if (!rc && worst > tk_tolerance_correction(r) && *iterations < most) {
+        cholmod_sparse *metric = NULL;
+        rc = metric_build(r, tk_nnls_common(r->shared.nnls), &metric, err);
+        if (!rc)
+            rc = newton_steps(r, most - *iterations, metric, &worst, iterations, err);
+        cholmod_free_sparse(&metric, tk_nnls_common(r->shared.nnls));
     }
     if (rc || worst <= tk_tolerance_correction(r))
         return rc;

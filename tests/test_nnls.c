@@ -731,7 +731,7 @@ START_TEST(degenerate_problems)
     ck_assert(rep.rcond == 1.0 && rep.iterations == 0);
     double du[6];
     double delta;
-    ck_assert_int_eq(tk_nnls_min_norm(s, A, NULL, 0.0, du, &delta, &err), TK_OK);
+    ck_assert_int_eq(tk_nnls_min_norm(s, A, NULL, 0.0, NULL, du, &delta, &err), TK_OK);
     for (int k = 0; k < 6; k++)
         ck_assert(du[k] == 0.0);
     cholmod_free_sparse(&A, cc);
@@ -839,7 +839,7 @@ static void check_min_norm(tk_nnls *s, const cholmod_sparse *A, tkt_rng *r, bool
     double *g = malloc((n + 1) * sizeof *g);
     double delta = -1;
     tk_error err;
-    ck_assert_msg(tk_nnls_min_norm(s, A, rr, 0.0, du, &delta, &err) == TK_OK, "%s: %s", what,
+    ck_assert_msg(tk_nnls_min_norm(s, A, rr, 0.0, NULL, du, &delta, &err) == TK_OK, "%s: %s", what,
                   err.message);
     ck_assert(delta == 0.0);
     /* A^T du = r */
@@ -922,7 +922,7 @@ START_TEST(min_norm_solutions)
     cholmod_sparse *A = sparse_from_dense(cc, 4, 3, D);
     double rr[3] = {1, 1, 2}, du[4], delta = 0;
     tk_error err;
-    ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, 0.0, du, &delta, &err), TK_OK);
+    ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, 0.0, NULL, du, &delta, &err), TK_OK);
     ck_assert(delta > 0.0);
     /* consistent right-hand side: A^T du = r still holds closely */
     ck_assert_double_eq_tol(du[0] + du[2], 1.0, 1e-6);
@@ -955,7 +955,7 @@ START_TEST(damped_min_norm_steps)
         double *g = malloc(n * sizeof *g), *kkt = malloc(m * sizeof *kkt);
         double delta = deltas[trial % 3], used = -1;
         tk_error err;
-        ck_assert_msg(tk_nnls_min_norm(s, A, rr, delta, du, &used, &err) == TK_OK, "%s",
+        ck_assert_msg(tk_nnls_min_norm(s, A, rr, delta, NULL, du, &used, &err) == TK_OK, "%s",
                       err.message);
         ck_assert(used >= delta);
         const int *Ap = A->p, *Ai = A->i;
@@ -984,9 +984,109 @@ START_TEST(damped_min_norm_steps)
     cholmod_sparse *A = flow_matrix(cc, &r, 4, 4);
     double rr[4] = {1, 2, 3, 4}, du[12];
     tk_error err;
-    ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, -1e-6, du, NULL, &err), TK_EINVAL);
-    ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, 1.0, du, NULL, &err), TK_EINVAL);
+    ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, -1e-6, NULL, du, NULL, &err), TK_EINVAL);
+    ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, 1.0, NULL, du, NULL, &err), TK_EINVAL);
     cholmod_free_sparse(&A, cc);
+    tk_nnls_free(&s);
+}
+END_TEST
+
+/* M = I + w S' S, S the second differences along the coordinates taken
+ * three apart (one axis of a closed chain of vertices): the shape of
+ * error recovery's metric. */
+static cholmod_sparse *bending_metric(cholmod_common *cc, size_t V, double w)
+{
+    size_t m = 3 * V;
+    double *D = calloc(m * m, sizeof *D);
+    for (size_t v = 0; v < V; v++)
+        for (size_t x = 0; x < 3; x++) {
+            size_t at[3] = {3 * ((v + V - 1) % V) + x, 3 * v + x, 3 * ((v + 1) % V) + x};
+            double row[3] = {1.0, -2.0, 1.0};
+            for (int a = 0; a < 3; a++)
+                for (int b = 0; b < 3; b++)
+                    D[at[a] + m * at[b]] += w * row[a] * row[b];
+        }
+    for (size_t i = 0; i < m; i++)
+        D[i + m * i] += 1.0;
+    cholmod_sparse *M = sparse_from_dense(cc, m, m, D);
+    free(D);
+    return M;
+}
+
+START_TEST(damped_steps_in_a_metric)
+{
+    /* The damped step in a metric M satisfies its own optimality condition
+     * A D^-1 (A^T du - r) + delta M du = 0, checked from A and M; with
+     * M = I it is the plain damped step; and it bends less than the plain
+     * one (du' S'S du, the quantity the metric weighs). */
+    tk_nnls *s = new_solver();
+    cholmod_common *cc = tk_nnls_common(s);
+    tkt_rng r = {31};
+    const double deltas[3] = {1e-6, 1e-4, 1e-2};
+    for (int trial = 0; trial < 30; trial++) {
+        size_t V = 5 + (size_t)(tkt_rng_next(&r) % 6), m = 3 * V;
+        size_t n = trial % 2 ? m + 1 + tkt_rng_next(&r) % 20 : 1 + tkt_rng_next(&r) % (m / 2);
+        double delta = deltas[trial % 3], w = 100.0;
+        cholmod_sparse *A = flow_matrix(cc, &r, V, n), *M = bending_metric(cc, V, w);
+        cholmod_sparse *eye = cholmod_speye(m, m, CHOLMOD_REAL, cc);
+        double *rr = random_vector(&r, n), *du = malloc(m * sizeof *du);
+        double *plain = malloc(m * sizeof *plain), *same = malloc(m * sizeof *same);
+        double *g = malloc(n * sizeof *g), *kkt = malloc(m * sizeof *kkt);
+        double used = -1.0;
+        tk_error err;
+        ck_assert_msg(tk_nnls_min_norm(s, A, rr, delta, M, du, &used, &err) == TK_OK, "%s",
+                      err.message);
+        ck_assert_double_eq(used, delta);
+        ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, delta, eye, same, NULL, &err), TK_OK);
+        ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, delta, NULL, plain, NULL, &err), TK_OK);
+        const int *Ap = A->p, *Ai = A->i, *Mp = M->p, *Mi = M->i;
+        const double *Ax = A->x, *Mx = M->x;
+        transpose_residual(A, du, rr, g);
+        memset(kkt, 0, m * sizeof *kkt);
+        double bend = 0.0, plain_bend = 0.0;
+        for (size_t j = 0; j < m; j++)
+            for (int e = Mp[j]; e < Mp[j + 1]; e++) {
+                kkt[Mi[e]] += delta * Mx[e] * du[j];
+                double sts = (Mx[e] - ((size_t)Mi[e] == j)) / w;
+                bend += du[Mi[e]] * sts * du[j];
+                plain_bend += plain[Mi[e]] * sts * plain[j];
+            }
+        for (size_t j = 0; j < n; j++) {
+            double d = column_norm(A, j);
+            for (int e = Ap[j]; e < Ap[j + 1]; e++)
+                kkt[Ai[e]] += Ax[e] * g[j] / (d * d);
+        }
+        double scale = delta * vnorm(du, m) + 1e-300;
+        ck_assert_msg(vnorm(kkt, m) <= 1e-6 * fmax(scale, vnorm(rr, n)),
+                      "trial %d (delta %g): optimality %g against %g", trial, delta,
+                      vnorm(kkt, m), scale);
+        double gap = 0.0;
+        for (size_t i = 0; i < m; i++)
+            gap = fmax(gap, fabs(same[i] - plain[i]));
+        ck_assert_msg(gap <= 1e-8 * vnorm(plain, m), "trial %d: identity metric off by %g",
+                      trial, gap);
+        ck_assert_msg(bend <= plain_bend * (1.0 + 1e-9), "trial %d: bends %g, plain %g", trial,
+                      bend, plain_bend);
+        free(rr);
+        free(du);
+        free(plain);
+        free(same);
+        free(g);
+        free(kkt);
+        cholmod_free_sparse(&A, cc);
+        cholmod_free_sparse(&M, cc);
+        cholmod_free_sparse(&eye, cc);
+    }
+    /* a metric needs a damping, and the step's order */
+    cholmod_sparse *A = flow_matrix(cc, &r, 5, 4), *M = bending_metric(cc, 5, 1.0),
+                   *small = bending_metric(cc, 4, 1.0);
+    double rr[4] = {1, 2, 3, 4}, du[15];
+    tk_error err;
+    ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, 0.0, M, du, NULL, &err), TK_EINVAL);
+    ck_assert_int_eq(tk_nnls_min_norm(s, A, rr, 1e-4, small, du, NULL, &err), TK_EINVAL);
+    cholmod_free_sparse(&A, cc);
+    cholmod_free_sparse(&M, cc);
+    cholmod_free_sparse(&small, cc);
     tk_nnls_free(&s);
 }
 END_TEST
@@ -1015,7 +1115,7 @@ static void *run_job(void *arg)
         double *b = random_vector(&r, 3 * jb->V), *rr = random_vector(&r, jb->n);
         jb->rc = tk_nnls_solve(s, A, b, jb->x + round * jb->n, NULL, NULL, &err);
         if (jb->rc == TK_OK)
-            jb->rc = tk_nnls_min_norm(s, A, rr, 0.0, jb->du + round * 3 * jb->V, NULL, &err);
+            jb->rc = tk_nnls_min_norm(s, A, rr, 0.0, NULL, jb->du + round * 3 * jb->V, NULL, &err);
         free(b);
         free(rr);
         cholmod_free_sparse(&A, cc);
@@ -1341,6 +1441,7 @@ int main(void)
     tcase_add_test(tc, repeat_solves_are_identical);
     tcase_add_test(tc, min_norm_solutions);
     tcase_add_test(tc, damped_min_norm_steps);
+    tcase_add_test(tc, damped_steps_in_a_metric);
     tcase_add_test(tc, two_threads_match_series);
     tcase_add_test(tc, proximal_problems);
     tcase_add_test(tc, proximal_rounds_on_wide_problems);

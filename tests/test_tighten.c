@@ -18,6 +18,7 @@
 #include "tk/thickness.h"
 #include "tk/record.h"
 #include "tk/tighten.h"
+#include "tk/vect.h"
 
 /* why a test skips in the quick form */
 #define LONG_RUN "a long run: the build without sanitizers runs it"
@@ -510,6 +511,58 @@ START_TEST(a_fine_start_is_set_up_with_the_tolerance_of_its_edges)
     ck_assert_uint_gt(wide.count, n);
     tk_strut_list_free(&wide);
     tk_strut_finder_free(&f);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
+START_TEST(a_fine_tight_polygon_is_restored_in_place)
+{
+    /* tests/data/trefoil-2400.vect: a tight trefoil of 4,800 vertices
+     * (ropelength 32.74378) resampled to 2,400.  Its struts are violated
+     * by up to 4.9e-6 of the diameter all along the curve, two radii of
+     * curvature by 9.4e-6 of the bound, and hundreds of others are within
+     * 1% of it.  The least-norm Newton steps on the violated constraints
+     * move single vertices and bend their neighbours past the bound (by
+     * 13% and more, at any damping), the inequality steps crawl, and the
+     * start was scaled up by 1 + 9.3e-6; steps measured by their bending
+     * as well must restore it in place. */
+    tk_curve *c = NULL;
+    tk_error err;
+    ck_assert_msg(tk_vect_read_file("tests/data/trefoil-2400.vect", NULL, &c, &err) == TK_OK,
+                  "%s", err.message);
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, NULL), TK_OK);
+    double before = tk_curve_length(c);
+    tk_options o = TK_OPTIONS_INIT;
+    o.coarse_to_fine = false;
+    o.escapes = 0;
+    o.max_steps = 1;
+    tk_run *run = NULL;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    const tk_curve *d = tk_run_curve(run);
+    tk_run_timing t;
+    tk_run_timing_get(run, &t);
+    tk_measure after;
+    ck_assert_int_eq(tk_thickness_measure(d, NULL, &after, NULL), TK_OK);
+    double h = tk_curve_length(d) / (double)tk_curve_edge_count(d);
+    /* the correction tolerance: a tenth of the overstep one, 0.3 h^2 */
+    double tolerance = 0.03 * h * h;
+    printf("fine trefoil: thickness 1 - %.3g, minrad 0.5 - %.3g; restored in %d corrections, "
+           "%ld rescales, thickness 1 + %.3g, length %+.3g, %zu struts\n",
+           1.0 - m.thickness, 0.5 - m.minrad, tk_run_latest(run)->corrections, t.rescales,
+           after.thickness - 1.0, tk_curve_length(d) / before - 1.0,
+           tk_run_latest(run)->struts);
+    ck_assert(d->nvert == c->nvert);
+    ck_assert(m.thickness < 1.0 - 4e-6 && m.minrad < 0.5 * (1.0 - 9e-6));
+    ck_assert_int_eq(t.rescales, 0);
+    ck_assert_msg(after.thickness >= 1.0 - tolerance, "thickness 1 - %.3g", 1.0 - after.thickness);
+    ck_assert_msg(after.minrad >= 0.5 * (1.0 - tolerance), "minrad 0.5 - %.3g",
+                  0.5 - after.minrad);
+    /* in place: the length changes by less than the least rescale would
+     * (1 + 9.4e-6, the worst violation) */
+    ck_assert_msg(fabs(tk_curve_length(d) / before - 1.0) < 9.4e-6, "length %+.3g",
+                  tk_curve_length(d) / before - 1.0);
     tk_run_free(&run);
     tk_curve_free(&c);
 }
@@ -1580,6 +1633,7 @@ int main(void)
     tcase_add_test(tc, round_hopf_start_with_continuum_of_contacts);
     tcase_add_test(tc, recovery_restores_thousands_of_contacts_without_rescaling);
     tcase_add_test(tc, a_fine_start_is_set_up_with_the_tolerance_of_its_edges);
+    tcase_add_test(tc, a_fine_tight_polygon_is_restored_in_place);
     tcase_add_test(tc, a_refined_tight_polygon_is_restored_without_rescaling);
     tcase_add_test(tc, a_loose_curve_is_kept_at_the_tube);
     tcase_add_test(tc, a_loose_start_keeps_its_final_count_through_escapes);

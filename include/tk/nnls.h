@@ -144,8 +144,13 @@ int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *
  * than coordinates, many dependent), the minimum-norm answer is long and
  * rounding-dominated and this one is not.  Zero columns of A are left out
  * (their rows of A^T du = r cannot hold unless r is 0 there).  delta_used
- * may be NULL.  Used for error recovery (section 4.6). */
+ * may be NULL.  Used for error recovery (section 4.6).
+ * With a metric M (m x m, symmetric positive definite, both triangles
+ * stored; NULL: the identity), the damping term is delta du' M du
+ * instead, du = (A D^-1 A^T + delta M)^-1 A D^-1 r, solved in that form
+ * (it needs delta_min > 0, which is then used as it is). */
 int tk_nnls_min_norm(tk_nnls *s, const cholmod_sparse *A, const double *r, double delta_min,
-                     double *du, double *delta_used, tk_error *err);
+                     const cholmod_sparse *metric, double *du, double *delta_used,
+                     tk_error *err);
 
 #endif
