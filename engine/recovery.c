@@ -3,6 +3,7 @@
  * a constraint set of its own, so the step's active set (with the forces
  * the step reports) is left as it was.  See run.h for the rooms of the
  * flow. */
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -240,7 +241,8 @@ static int metric_build(const tk_run *r, cholmod_common *cc, cholmod_sparse **ou
     size_t m = 3 * c->nvert;
     double l2 = r->tau * r->min_radius;
     *out = NULL;
-    cholmod_triplet *t = cholmod_allocate_triplet(m, m, 9 * m, 0, CHOLMOD_REAL, cc);
+    /* nine entries a vertex: its three rows of three */
+    cholmod_triplet *t = cholmod_allocate_triplet(m, m, 3 * m, 0, CHOLMOD_REAL, cc);
     if (!t)
         return tk_error_set(err, TK_ENOMEM, "out of memory for a recovery step");
     int *ti = t->i, *tj = t->j;
@@ -273,6 +275,7 @@ static int metric_build(const tk_run *r, cholmod_common *cc, cholmod_sparse **ou
                 }
         }
     }
+    assert(t->nnz <= t->nzmax && rows <= m);
     t->ncol = rows;
     int rc = TK_OK;
     double one[2] = {1.0, 0.0};
