@@ -94,6 +94,8 @@ struct tk_run {
         double *x;       /* compressions, one per constraint */
         size_t x_capacity;
         bool kept;       /* the last solve's factor is kept (tk/nnls.h) */
+        double weight;   /* the proximal weight the last such solve ended
+                            at (0: none) */
         double nnls_seconds;
         long nnls_solves, nnls_iterations, factorisations;
     } motion;
