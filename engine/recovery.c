@@ -500,6 +500,7 @@ static int correct(tk_run *r, int most, double rescale_up_to, int *iterations, t
             break;
     }
     if (!rc && worst > tk_tolerance_correction(r) && *iterations < most) {
+        r->recovery.bent++;
         cholmod_sparse *metric = NULL;
         rc = metric_build(r, tk_nnls_common(r->shared.nnls), &metric, err);
         if (!rc)

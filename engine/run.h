@@ -117,6 +117,7 @@ struct tk_run {
         double checked_worst;
         double seconds, nnls_seconds, check_seconds;
         long rescales, undone;
+        long bent;       /* corrections that needed the bending metric */
         double largest_rescale; /* scale factor - 1 */
     } recovery;
 

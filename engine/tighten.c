@@ -516,6 +516,7 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out)
         .invariants = r->type.seconds + r->escape.type_seconds,
         .undone_steps = r->recovery.undone,
         .rescales = r->recovery.rescales,
+        .bent_corrections = r->recovery.bent,
         .largest_rescale = r->recovery.largest_rescale,
     };
 }

@@ -905,6 +905,9 @@ static int cmd_tighten(int argc, char **argv)
                t.undone_steps, t.rescales);
         if (t.rescales > 0)
             printf(" (largest by a factor 1 + %.3g)", t.largest_rescale);
+        if (t.bent_corrections > 0)
+            printf("; %ld correction%s needed steps weighed by their bending",
+                   t.bent_corrections, t.bent_corrections == 1 ? "" : "s");
         putchar('\n');
         size_t ne = 0;
         const tk_escape *e = tk_run_escapes(run, &ne);

@@ -265,8 +265,10 @@ typedef struct tk_run_timing {
     /* Error recovery's last resorts: steps undone and taken again shorter
      * because Newton steps could not restore the thickness, and rescalings
      * of the whole curve about its centroid (not counting autoscale) with
-     * the largest factor - 1. */
-    long undone_steps, rescales;
+     * the largest factor - 1; and the corrections whose Newton and
+     * inequality steps could not restore it, and which went on to steps
+     * weighed by their bending as well (section 4.6 on fine polygons). */
+    long undone_steps, rescales, bent_corrections;
     double largest_rescale;
 } tk_run_timing;
 
