@@ -2024,26 +2024,19 @@ static int metric_solve(tk_nnls *s, const cholmod_sparse *P, const cholmod_spars
     X.x = du;
     X.xtype = CHOLMOD_REAL;
     X.dtype = CHOLMOD_DOUBLE;
+    /* each pass solves for the residual res = P (c - P' du) - delta M du
+     * (at du = 0: P c) and adds the answer to du */
+    double minus_delta[2] = {-delta, 0.0};
+    cholmod_dense R = X;
+    R.x = res;
     const double *sol;
-    t_times(P, c, res);
     memset(du, 0, m * sizeof *du);
-    for (int step = 0; step < 3 && rc == TK_OK; step++) {
-        if (step > 0) {
-            /* res = P c - P P' du - delta M du */
-            cholmod_dense R = X;
-            R.x = res;
-            t_times(P, c, res);
-            t_transpose_times(P, du, w);
-            for (size_t k = 0; k < P->ncol; k++)
-                w[k] = -w[k];
-            double minus_delta[2] = {-delta, 0.0};
-            cholmod_sdmult((cholmod_sparse *)M, 0, minus_delta, one, &X, &R, &s->cc);
-            const int *Pp = P->p, *Pi = P->i;
-            const double *Px = P->x;
-            for (size_t k = 0; k < P->ncol; k++)
-                for (int e = Pp[k]; e < Pp[k + 1]; e++)
-                    res[Pi[e]] += Px[e] * w[k];
-        }
+    for (int pass = 0; pass < 3 && rc == TK_OK; pass++) {
+        t_transpose_times(P, du, w);
+        for (size_t k = 0; k < P->ncol; k++)
+            w[k] = c[k] - w[k];
+        t_times(P, w, res);
+        cholmod_sdmult((cholmod_sparse *)M, 0, minus_delta, one, &X, &R, &s->cc);
         if ((rc = factor_solve(s, L, res, m, &sol, err)) == TK_OK)
             for (size_t i = 0; i < m; i++)
                 du[i] += sol[i];
