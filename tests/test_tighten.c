@@ -389,6 +389,69 @@ START_TEST(trefoil_does_not_stall_near_its_critical_point)
 }
 END_TEST
 
+/* A step's merit (stepping.c): its length over the thickness its
+ * violation leaves, from the step's own figures. */
+typedef struct merit_watch {
+    tk_step_report last;
+    long checked;   /* steps with no correction on the polygon before them */
+    long rises;     /* of those, steps whose merit rose */
+    double largest; /* the largest rise, relative */
+} merit_watch;
+
+static int watch_merit(const tk_step_report *s, void *user)
+{
+    merit_watch *w = user;
+    const tk_step_report *p = &w->last;
+    /* a step corrected after it, a step of none, and the first on a new
+     * polygon (refined, or deformed by an escape) answer for more than the
+     * step itself */
+    if (s->step > 1 && s->corrections == 0 && s->step_size > 0.0 &&
+        s->vertices == p->vertices && s->escapes == p->escapes) {
+        double before = p->length / (1.0 - p->violation), after = s->length / (1.0 - s->violation);
+        w->checked++;
+        if (after > before * (1.0 + 1e-13)) {
+            w->rises++;
+            w->largest = fmax(w->largest, after / before - 1.0);
+        }
+    }
+    w->last = *s;
+    return 0;
+}
+
+START_TEST(a_step_lowers_the_ropelength_it_leaves)
+{
+    /* A step is accepted within the overstep tolerance and its violation
+     * corrected after it: judged by its length alone it may gain less than
+     * its violation costs, and the run then cycles between such steps and
+     * their corrections (stepping.c).  Every step that needs no correction
+     * must lower its length over the thickness it leaves. */
+    if (quick() || !tkt_catalogue_dir()) {
+        tkt_skip("steps lower the ropelength they leave",
+                 quick() ? LONG_RUN : "the catalogue is absent");
+        return;
+    }
+    tk_curve *c = tkt_catalogue_curve("3.1.vect");
+    tk_options o = TK_OPTIONS_INIT;
+    o.resolution = 5;
+    o.max_steps = 1600;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    merit_watch w = {.last = *tk_run_latest(run)};
+    tk_run_set_progress(run, watch_merit, &w);
+    tk_stop_reason why;
+    ck_assert_int_eq(tk_run_until(run, &why, &err), TK_OK);
+    printf("steps with no correction: %ld, of which %ld raised the ropelength they leave "
+           "(by %.3g at most)\n",
+           w.checked, w.rises, w.largest);
+    ck_assert_msg(w.checked >= 1000, "only %ld steps checked", w.checked);
+    ck_assert_msg(w.rises == 0, "%ld of %ld steps raised it, by %.3g at most", w.rises, w.checked,
+                  w.largest);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(round_hopf_start_with_continuum_of_contacts)
 {
     /* Two round circles through each other's centres: every point of one
@@ -1635,6 +1698,7 @@ int main(void)
     tcase_add_test(tc, vertices_option_ends_at_exactly_that_count);
     tcase_add_test(tc, cancellation_stops_within_one_step);
     tcase_add_test(tc, parallel_runs_equal_serial_runs);
+    tcase_add_test(tc, a_step_lowers_the_ropelength_it_leaves);
     tcase_add_test(tc, round_hopf_start_with_continuum_of_contacts);
     tcase_add_test(tc, recovery_restores_thousands_of_contacts_without_rescaling);
     tcase_add_test(tc, a_fine_start_is_set_up_with_the_tolerance_of_its_edges);
