@@ -54,15 +54,15 @@ static double largest_step(const tk_run *r, double fastest_vertex)
 /* What a step must lower: the length over the thickness a violation
  * leaves, 1 - worst (worst as tk_recovery_violation gives it), the
  * ropelength of the curve scaled back to its tube.  A step is accepted
- * within the overstep tolerance and its violation corrected at the next
- * (down to a tenth of that), at a cost in length about the violation's:
- * a step judged by its length alone, along constraints that curve, can
- * lose to the correction all that it gained.  Catalogue 8.19 at 489
- * vertices after 600 s (60.99997), tightened again for 120 s without
- * escapes: judged by the length, 2,927 of its 6,328 steps raised the
- * ropelength and 2,188 needed corrections, cycling between a step and its
- * correction, and it ended at 60.99632; judged by this, 34 of 4,366 and
- * 16, at 60.99535. */
+ * within the overstep tolerance, and its violation, when over half of it,
+ * corrected right after (down to a tenth), at a cost in length about the
+ * violation's: a step judged by its length alone, along constraints that
+ * curve, can lose to the correction all that it gained.  Catalogue 8.19
+ * at 489 vertices after 600 s (60.99997), tightened again for 120 s
+ * without escapes: judged by the length, 2,927 of its 6,328 steps raised
+ * the ropelength and 2,188 needed corrections, cycling between a step and
+ * its correction, and it ended at 60.99632; judged by this, 34 of 4,366
+ * and 16, at 60.99535. */
 static double merit(const tk_curve *c, double worst)
 {
     return tk_curve_length(c) / (1.0 - worst);

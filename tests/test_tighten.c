@@ -402,9 +402,9 @@ static int watch_merit(const tk_step_report *s, void *user)
 {
     merit_watch *w = user;
     const tk_step_report *p = &w->last;
-    /* a step corrected after it, a step of none, and the first on a new
-     * polygon (refined, or deformed by an escape) answer for more than the
-     * step itself */
+    /* a step corrected after it, a step of size 0 (the curve corrected
+     * or left), and the first on a new polygon (refined, or deformed by
+     * an escape) answer for more than the step itself */
     if (s->step > 1 && s->corrections == 0 && s->step_size > 0.0 &&
         s->vertices == p->vertices && s->escapes == p->escapes) {
         double before = p->length / (1.0 - p->violation), after = s->length / (1.0 - s->violation);
