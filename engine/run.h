@@ -151,6 +151,8 @@ struct tk_run {
                                     outside the tolerance) */
         int best_polish;     /* its polishing level */
         bool due;            /* deform before the next step */
+        bool reserved;       /* the budget's reserve for the best has begun */
+        bool polishing;      /* the curve is the best put back, not a try */
         tk_escape *log;      /* one per try */
         size_t nlog, log_capacity;
         int improved;
@@ -322,6 +324,9 @@ bool tk_escape_converged(const tk_run *r);
 /* Asks for an escape before the next step when tries and budget remain
  * (the attempt that converged is noted); false when none is left. */
 bool tk_escape_ask(tk_run *r);
+/* Once the budget's reserve for polishing the best curve begins: asks
+ * for the best back when the try under way is behind it. */
+bool tk_escape_reserve(tk_run *r);
 /* Before a step: the deformation (or, with no tries left, the best curve
  * back) when asked for. */
 int tk_escape_before_step(tk_run *r, tk_error *err);

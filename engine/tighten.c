@@ -281,6 +281,8 @@ static void check_stop(tk_run *r)
                      (stop == TK_STOP_NONE && tk_escape_converged(r));
     if (converged && tk_escape_ask(r))
         stop = TK_STOP_NONE;
+    else if (stop == TK_STOP_NONE)
+        tk_escape_reserve(r);
     if (tk_schedule_share_spent(r)) {
         tk_schedule_move_on(r);
         /* a stop on the budget has spent >= 1, above every share */

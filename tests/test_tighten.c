@@ -1678,6 +1678,57 @@ START_TEST(a_crawling_run_escapes_after_a_fifth_of_its_budget)
 }
 END_TEST
 
+/* The last fifth of the budget polishes the best curve (escape.c's
+ * reserve): no escape starts in it, and a try still behind the best when
+ * it begins is given up for the best, on the final polygon.  The Hopf
+ * link of escaping_run with 2,000 steps: at step 1,600 its second try
+ * (loosened many times over) is still far from tight.  The best is
+ * reckoned here from the steps' own reports. */
+START_TEST(the_last_fifth_of_the_budget_polishes_the_best)
+{
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_chain(2, 40, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.max_steps = 2000;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_msg(tk_run_until(run, NULL, &err) == TK_OK, "%s", err.message);
+    size_t nh = 0, ne = 0;
+    const tk_step_report *h = tk_run_history(run, &nh);
+    const tk_escape *e = tk_run_escapes(run, &ne);
+    ck_assert_uint_ge(ne, 1);
+    ck_assert_int_lt((int)ne, o.escapes); /* tries were left: the reserve stopped them */
+    for (size_t k = 0; k < ne; k++)
+        ck_assert_int_lt(5 * e[k].step, 4 * o.max_steps);
+    /* the first step in the reserve, the best before it */
+    size_t at = 0;
+    while (at < nh && 5 * h[at].step < 4 * o.max_steps)
+        at++;
+    ck_assert_uint_lt(at + 1, nh);
+    ck_assert_int_eq(h[at + 1].step, h[at].step + 1);
+    size_t final = tk_run_curve(run)->nvert;
+    double best = INFINITY;
+    for (size_t i = 0; i <= at; i++)
+        if (h[i].vertices == final)
+            best = fmin(best, h[i].ropelength);
+    printf("reserve: at step %ld the try %d stood at %.6f on %zu vertices; the best %.9f, "
+           "the next step %.9f, the end %.9f\n",
+           h[at].step, h[at].escapes, h[at].ropelength, h[at].vertices, best,
+           h[at + 1].ropelength, tk_run_latest(run)->ropelength);
+    ck_assert(h[at].vertices != final || h[at].ropelength > best * (1.0 + 1e-3));
+    ck_assert_uint_eq(h[at + 1].vertices, final);
+    ck_assert(fabs(h[at + 1].ropelength - best) <= 1e-5 * best);
+    ck_assert(tk_run_latest(run)->ropelength <= h[at + 1].ropelength);
+    /* what the polish reached is not the given-up try's */
+    ck_assert(isnan(e[ne - 1].reached) || e[ne - 1].reached > best * (1.0 + 1e-3));
+    ck_assert(!e[ne - 1].improved);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("tighten");
@@ -1693,6 +1744,7 @@ int main(void)
     tcase_add_test(tc, a_resumed_run_goes_on_where_it_was);
     tcase_add_test(tc, a_resumed_run_keeps_its_escapes);
     tcase_add_test(tc, a_crawling_run_escapes_after_a_fifth_of_its_budget);
+    tcase_add_test(tc, the_last_fifth_of_the_budget_polishes_the_best);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
     tcase_add_test(tc, vertices_option_ends_at_exactly_that_count);

@@ -116,9 +116,10 @@
       "them whenever it all but stops falling")                                              \
     X(escapes, INT, 8, 0, 1000, "escapes",                                                   \
       "most escapes: each time the ropelength all but stops falling on the final polygon "   \
-      "(or has crawled there for a fifth of the budget) while a tenth of the budget is "     \
-      "left, the best curve so far is deformed at random (every second time loosened many "  \
-      "times over) and tightened again; the result is the best curve found (0: none)")      \
+      "(or has crawled there for a fifth of the budget) before the last fifth of the "       \
+      "budget, the best curve so far is deformed at random (every second time loosened "     \
+      "many times over) and tightened again; the last fifth polishes the best curve; the "   \
+      "result is the best curve found (0: none)")                                            \
     X(seed, SEED, 1, 0, 9007199254740992.0, "seed",                                          \
       "of the escapes' random deformations: the same seed, the same run")
 
@@ -223,8 +224,9 @@ const tk_kink *tk_run_kinks(const tk_run *r, size_t *count);
 tk_stop_reason tk_run_stop_reason(const tk_run *r);
 
 /* One escape: where it started, the best ropelength then, and what its
- * tightening reached on the final polygon (NAN while under way or when
- * the run stopped first). */
+ * tightening reached on the final polygon (NAN while under way, or when
+ * the run stopped or gave it up first: the last fifth of the budget
+ * polishes the best curve, and what that reaches is no try's). */
 typedef struct tk_escape {
     long step;          /* the step after which the deformation was made */
     double from;        /* the best ropelength when it started */
