@@ -911,11 +911,14 @@ static int cmd_tighten(int argc, char **argv)
         putchar('\n');
         size_t ne = 0;
         const tk_escape *e = tk_run_escapes(run, &ne);
-        for (size_t k = 0; k < ne; k++)
-            printf("  escape %zu after step %ld: from %.9g, deformed by %.3g diameters, "
-                   "reached %.9g%s\n",
-                   k + 1, e[k].step, e[k].from, e[k].amplitude, e[k].reached,
-                   e[k].improved ? " (better)" : "");
+        for (size_t k = 0; k < ne; k++) {
+            printf("  escape %zu after step %ld: from %.9g, deformed by %.3g diameters, ", k + 1,
+                   e[k].step, e[k].from, e[k].amplitude);
+            if (isnan(e[k].reached))
+                printf("stopped before the final polygon\n");
+            else
+                printf("reached %.9g%s\n", e[k].reached, e[k].improved ? " (better)" : "");
+        }
     }
 done:
     if (w.log && fclose(w.log) != 0) {
