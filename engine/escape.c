@@ -68,8 +68,9 @@
  * and its best, 61.00424, polished for 100 s when the tries were spent,
  * went on to 61.0000 after 31 s and 60.9967 after 100 s; seed 2, whose
  * last try ran to the end, ended at 61.00027 with that best at 61.00429
- * never polished.  With the reserve the two end at 60.99625 and 60.99631,
- * below the atlas's 60.99699. */
+ * never polished.  With the reserve seed 2 gave up a far try at 61.10
+ * for that best at 480 s and ended at 60.99631, below the atlas's
+ * 60.99699 (seed 1 spends its tries before the reserve). */
 #define ESCAPE_RESERVE 0.2
 
 void tk_escape_free(tk_run *r)
