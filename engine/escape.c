@@ -144,19 +144,18 @@ bool tk_escape_ask(tk_run *r)
     return r->escape.due;
 }
 
-bool tk_escape_reserve(tk_run *r)
+void tk_escape_reserve(tk_run *r)
 {
     if (r->escape.reserved || r->escape.due || tk_escape_tries(r) == 0 ||
         tk_schedule_spent(r) < 1.0 - ESCAPE_RESERVE)
-        return false;
+        return;
     r->escape.reserved = true;
     if (note(r, NULL) != TK_OK)
-        return false; /* out of memory for the copy: the try goes on */
+        return; /* out of memory for the copy: the try goes on */
     /* a try on a coarser polygon is behind by its nature: its ropelength
      * does not compare with the final polygon's */
     r->escape.due = r->escape.best && (!tk_schedule_final(r) ||
                                        r->escape.best_report.ropelength < r->life.latest.ropelength);
-    return r->escape.due;
 }
 
 /* c displaced by the modes coef (per component, ESCAPE_MODES x 2 x 3

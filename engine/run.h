@@ -325,8 +325,8 @@ bool tk_escape_converged(const tk_run *r);
  * (the attempt that converged is noted); false when none is left. */
 bool tk_escape_ask(tk_run *r);
 /* Once the budget's reserve for polishing the best curve begins: asks
- * for the best back when the try under way is behind it. */
-bool tk_escape_reserve(tk_run *r);
+ * for the best back (escape.due) when the try under way is behind it. */
+void tk_escape_reserve(tk_run *r);
 /* Before a step: the deformation (or, with no tries left, the best curve
  * back) when asked for. */
 int tk_escape_before_step(tk_run *r, tk_error *err);
