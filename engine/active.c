@@ -124,7 +124,8 @@ static bool has_strut(const tk_strut_list *list, const tk_strut *s)
  * is not enough: the equalising motion keeps the two edges equally long,
  * the resolved motion then keeps the one function to first order while
  * the other falls at first order, and the step control must shrink the
- * step in proportion to the tolerance. */
+ * step in proportion to the tolerance.  Kinks have a tolerance of their
+ * own (tk_tolerance_kink): their functions are stiffer. */
 int tk_active_find(tk_run *r, const tk_curve *c, tk_constraints *set, tk_error *err)
 {
     double t0 = tk_clock();
@@ -135,13 +136,14 @@ int tk_active_find(tk_run *r, const tk_curve *c, tk_constraints *set, tk_error *
                                         r->tau * slack, &set->struts, err);
     tk_kink *found = NULL;
     size_t nfound = 0;
+    double bent = 1.0 + tk_tolerance_kink(r);
     if (!rc)
-        rc = tk_kinks_find(c, 2.0 * r->min_radius * slack, &found, &nfound, err);
+        rc = tk_kinks_find(c, 2.0 * r->min_radius * bent, &found, &nfound, err);
     for (size_t k = 0; !rc && k < nfound; k++) {
         size_t v = tk_curve_vertex_index(c, found[k].comp, found[k].vertex);
         for (int edge = 0; edge < 2 && !rc; edge++) {
             double radius = tk_branch_radius(c, v, edge);
-            if (radius <= r->min_radius * slack)
+            if (radius <= r->min_radius * bent)
                 rc = push_kink(set, found[k].comp, found[k].vertex, edge, radius, err);
         }
     }
@@ -316,8 +318,10 @@ static int compare_kink_vertices(const void *pa, const void *pb)
     return a->vertex < b->vertex ? -1 : (a->vertex > b->vertex ? 1 : 0);
 }
 
-/* One per vertex, with its radius (equation 3) and the sum of its
- * constraints' forces. */
+/* One per vertex at the curvature bound, with its radius (equation 3)
+ * and the sum of its constraints' forces: the kinks that hold the motion
+ * or are within the struts' active tolerance (the kinks' own is wider,
+ * tk_tolerance_kink, and holds vertices a tenth from the bound). */
 int tk_active_report(tk_run *r, tk_error *err)
 {
     const tk_constraints *set = &r->active.set;
@@ -333,6 +337,7 @@ int tk_active_report(tk_run *r, tk_error *err)
     qsort(out, set->nkinks, sizeof *out, compare_kink_vertices);
     size_t n = 0;
     const tk_curve *c = r->shared.curve;
+    double near = r->min_radius * (1.0 + tk_tolerance_active(r));
     for (size_t k = 0; k < set->nkinks; k++) {
         if (n > 0 && compare_kink_vertices(&out[n - 1], &out[k]) == 0) {
             out[n - 1].force += out[k].force;
@@ -341,7 +346,9 @@ int tk_active_report(tk_run *r, tk_error *err)
         out[n] = out[k];
         size_t v = tk_curve_vertex_index(c, out[n].comp, out[n].vertex);
         out[n].minrad = fmin(tk_branch_radius(c, v, 0), tk_branch_radius(c, v, 1));
-        n++;
+        /* (a vertex's other edge, next in order, is then looked at alone) */
+        if (out[n].force > 0.0 || out[n].minrad <= near)
+            n++;
     }
     r->active.report = out;
     r->active.nreport = n;

@@ -379,6 +379,7 @@ size_t tk_schedule_final_count(const tk_run *r);
 size_t tk_schedule_window(const tk_run *r, size_t steps);
 double tk_tolerance_active(const tk_run *r);
 double tk_tolerance_overstep(const tk_run *r);
+double tk_tolerance_kink(const tk_run *r);
 double tk_tolerance_correction(const tk_run *r);
 
 #endif
