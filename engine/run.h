@@ -104,6 +104,7 @@ struct tk_run {
         double step_size;
         int tiny_steps;
         double seconds;
+        long length_steps; /* judged by their length (take_step) */
     } stepping;
 
     struct {             /* recovery.c */

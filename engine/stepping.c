@@ -183,6 +183,7 @@ static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *al
             for (size_t i = 0; i < n3; i++)
                 c->xyz[i] += last_h * motion[i];
             r->stepping.step_size = last_h;
+            r->stepping.length_steps++;
             rep->step_size = last_h;
             tk_strut_finder_refit(finder, c);
             return TK_OK;

@@ -519,6 +519,7 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out)
         .undone_steps = r->recovery.undone,
         .rescales = r->recovery.rescales,
         .bent_corrections = r->recovery.bent,
+        .length_steps = r->stepping.length_steps,
         .largest_rescale = r->recovery.largest_rescale,
     };
 }

@@ -909,6 +909,10 @@ static int cmd_tighten(int argc, char **argv)
             printf("; %ld correction%s needed steps weighed by their bending",
                    t.bent_corrections, t.bent_corrections == 1 ? "" : "s");
         putchar('\n');
+        if (t.length_steps > 0)
+            printf("  step control: %ld step%s judged by the length alone (along the motion the "
+                   "length over the thickness rose at first order)\n",
+                   t.length_steps, t.length_steps == 1 ? "" : "s");
         size_t ne = 0;
         const tk_escape *e = tk_run_escapes(run, &ne);
         for (size_t k = 0; k < ne; k++) {

@@ -272,6 +272,11 @@ typedef struct tk_run_timing {
      * weighed by their bending as well (section 4.6 on fine polygons). */
     long undone_steps, rescales, bent_corrections;
     double largest_rescale;
+    /* Steps judged by their length alone: the length over the thickness
+     * their violation leaves rose at first order in the step size, so no
+     * shorter step lowered it (section 4.5's step control; the NNLS answer
+     * is not exact enough for the stiff kinks of a fine polygon). */
+    long length_steps;
 } tk_run_timing;
 
 void tk_run_timing_get(const tk_run *r, tk_run_timing *out);
