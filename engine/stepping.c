@@ -163,22 +163,21 @@ static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *al
             last_h = last_rise = 0.0;
             continue;
         }
-        /* The merit's rise is c h + b h^2: halving h takes it to between
-         * a quarter and a half of itself, nearer a half the more the first
-         * order term weighs.  The resolved motion keeps every active
-         * constraint to first order only as far as the NNLS answer is
-         * exact: where the factor is kept (motion.c) its rates are off by
-         * some 1e-5 relative, and a kink's radius function, whose
-         * gradient is about (tau / e)^2 times a strut's for edges e, then
-         * falls at a relative rate that the shortening, |v|^2 / L, cannot
-         * pay.  The tight trefoil at 2,400 vertices (bench/steps --curve):
-         * a kink at 1.6e-3 h against 3.2e-6 h; judged by the merit alone
-         * it stayed at 32.743394 through 145 steps of 3.7 s, each halving
-         * down to a few 1e-8 and resolving after every new constraint.
-         * There the step is judged by its length, as in the paper, and the
-         * correction after it pays for the violation; where the rise is of
-         * second order (a step too long along a curved constraint),
-         * halving on finds one that lowers the merit. */
+        /* The merit's rise is c h + b h^2: halving h takes it to between a
+         * quarter and a half of itself, nearer a half the more the first order
+         * term weighs.  The resolved motion keeps every active constraint to
+         * first order only as far as the NNLS answer is exact: where the factor
+         * is kept (motion.c) its rates are off by some 1e-5 relative, and a
+         * kink's radius function, which moves some (rho / tau) / e^2 times as
+         * fast as a strut's distance for edges e (schedule.c), then falls at a
+         * relative rate that the shortening, |v|^2 / L, cannot pay.  The tight
+         * trefoil at 2,400 vertices (bench/steps --curve): a kink at 1.6e-3 h
+         * against 3.2e-6 h; judged by the merit alone it stayed at 32.743394
+         * through 145 steps of 3.7 s, each halving down to a few 1e-8 and
+         * resolving after every new constraint.  There the step is judged by
+         * its length, as in the paper, and the correction after it pays for the
+         * violation; where the rise is of second order (a step too long along a
+         * curved constraint), halving on finds one that lowers the merit. */
         if (last_h > 0.0 && rise > FIRST_ORDER_SHARE * last_rise) {
             for (size_t i = 0; i < n3; i++)
                 c->xyz[i] += last_h * motion[i];
