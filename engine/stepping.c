@@ -63,9 +63,9 @@ static double largest_step(const tk_run *r, double fastest_vertex)
  * the ropelength and 2,188 needed corrections, cycling between a step and
  * its correction, and it ended at 60.99632; judged by this, 34 of 4,366
  * and 16, at 60.99535. */
-static double merit(const tk_curve *c, double worst)
+static double merit(double length, double worst)
 {
-    return tk_curve_length(c) / (1.0 - worst);
+    return length / (1.0 - worst);
 }
 
 /* A step that shortens the curve but raises the merit at 2h, and at h by
@@ -104,7 +104,7 @@ static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *al
     double worst_before;
     if ((rc0 = tk_recovery_violation(r, c, &worst_before, err)) != TK_OK)
         return rc0;
-    double merit_before = merit(c, worst_before);
+    double length_before = tk_curve_length(c), merit_before = merit(length_before, worst_before);
     /* the last step size tried that shortened the curve within the
      * tolerance but raised the merit, and by how much */
     double last_h = 0.0, last_rise = 0.0;
@@ -152,14 +152,14 @@ static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *al
          * nothing (see merit). */
         if (worst > tk_tolerance_overstep(r))
             continue;
-        double rise = merit(t, worst) - merit_before;
+        double length = tk_curve_length(t), rise = merit(length, worst) - merit_before;
         if (rise < 0.0) {
             memcpy(c->xyz, t->xyz, n3 * sizeof *c->xyz);
             r->stepping.step_size = h;
             rep->step_size = h;
             return TK_OK;
         }
-        if (!(tk_curve_length(t) < tk_curve_length(c))) {
+        if (!(length < length_before)) {
             last_h = last_rise = 0.0;
             continue;
         }
