@@ -139,6 +139,7 @@ struct tk_run {
         size_t resampled_from; /* history entries before the last resampling */
         double share_from;   /* budget spent when the current schedule began
                                 (an escape starts it again) */
+        int restarts;        /* tk_schedule_restart's curves taken */
     } schedule;
 
     struct {             /* escape.c */

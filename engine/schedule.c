@@ -396,6 +396,7 @@ int tk_schedule_resume(tk_run *r, const tk_curve *curve, const tk_resume *at, tk
     r->schedule.coarse_level = at->coarse_level;
     r->schedule.polish_level = at->polish_level;
     r->schedule.share_from = at->share_from;
+    r->schedule.restarts = at->restarts;
     r->schedule.resolved_at = at->resolved_at > 0.0 ? at->resolved_at : INFINITY;
     tk_measure m;
     int rc = tk_curve_copy(curve, &r->shared.curve, err);
@@ -414,6 +415,7 @@ void tk_schedule_resume_point(const tk_run *r, tk_resume *out)
     out->coarse_level = r->schedule.coarse_level;
     out->polish_level = r->schedule.polish_level;
     out->share_from = r->schedule.share_from;
+    out->restarts = r->schedule.restarts;
     out->resolved_at = isfinite(r->schedule.resolved_at) ? r->schedule.resolved_at : 0.0;
     out->final_ropelength = r->schedule.final_ropelength;
 }
@@ -534,6 +536,7 @@ int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_
 {
     tk_curve_free(&r->shared.curve);
     r->shared.curve = curve;
+    r->schedule.restarts++;
     r->schedule.share_from = tk_schedule_spent(r);
     r->schedule.move_on = false;
     size_t count = curve->nvert;

@@ -87,6 +87,7 @@ static int record(tk_run *r, tk_step_report *rep, tk_error *err)
     rep->ropelength = m.ropelength;
     rep->vertices = r->shared.curve->nvert;
     rep->escapes = tk_escape_tries(r);
+    rep->restarts = r->schedule.restarts;
     rep->seconds = tk_clock() - r->life.started;
     if (r->life.nhistory == r->life.history_capacity) {
         size_t cap = r->life.history_capacity ? 2 * r->life.history_capacity : 256;

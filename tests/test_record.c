@@ -45,7 +45,7 @@ START_TEST(tables_describe_their_structs)
     for (size_t i = 0; i < tk_step_nfields; i++)
         ck_assert(tk_field_get(&tk_step_fields[i], &s) == (double)(i + 1));
     ck_assert_int_eq(s.step, 1);
-    ck_assert_int_eq(s.escapes, (int)tk_step_nfields);
+    ck_assert_int_eq(s.restarts, (int)tk_step_nfields); /* the last field */
 }
 END_TEST
 

@@ -1619,15 +1619,18 @@ START_TEST(a_resumed_run_keeps_its_escapes)
     tk_resume at;
     tk_run *second = interrupted(first, tk_run_latest(first)->step + 5, &at);
     ck_assert_int_eq(at.escapes, 1);
+    ck_assert_int_eq(at.restarts, 1); /* the escape's curve */
     ck_assert(at.draws > 0);
     tk_step_report kept;
     ck_assert_ptr_nonnull(tk_run_best(second, &kept));
     ck_assert(kept.ropelength == best.ropelength);
     ck_assert_int_eq(tk_run_latest(second)->escapes, 1);
+    ck_assert_int_eq(tk_run_latest(second)->restarts, 1);
     /* the random stream's place reads back as it was set */
     tk_resume again;
     tk_run_resume_point(second, &again);
     ck_assert_int_eq(again.draws, at.draws);
+    ck_assert_int_eq(again.restarts, 1);
     ck_assert_int_eq(tk_run_until(second, NULL, &err), TK_OK);
     const tk_step_report *end = tk_run_latest(second);
     printf("resumed during an escape: best %.9f, ended %.9f after %d escapes\n",
@@ -1751,6 +1754,29 @@ START_TEST(the_last_fifth_of_the_budget_polishes_the_best)
     /* what the polish reached is not the given-up try's */
     ck_assert(isnan(e[ne - 1].reached) || e[ne - 1].reached > best * (1.0 + 1e-3));
     ck_assert(!e[ne - 1].improved);
+    /* the steps say where the curve was replaced: at each escape (a
+     * looser curve) and where the best was put back, and nowhere else
+     * does the ropelength rise by more than a step's correction */
+    ck_assert_int_eq(h[0].restarts, 0);
+    int put_back = 0;
+    for (size_t i = 1; i < nh; i++) {
+        int more = h[i].restarts - h[i - 1].restarts;
+        bool escaped = h[i].escapes > h[i - 1].escapes;
+        bool replaced = escaped || i == at + 1;
+        /* (the run's end may put the best back once more, as its last record) */
+        ck_assert_msg(more == replaced || (more == 1 && i + 1 == nh),
+                      "step %ld: restarts %d -> %d, escapes %d -> %d", h[i].step,
+                      h[i - 1].restarts, h[i].restarts, h[i - 1].escapes, h[i].escapes);
+        if (escaped)
+            ck_assert(h[i].ropelength > 1.01 * h[i - 1].ropelength);
+        else if (more == 0 && h[i].vertices == h[i - 1].vertices)
+            ck_assert_msg(h[i].ropelength <= (1.0 + 1e-3) * h[i - 1].ropelength,
+                          "step %ld: %.9f -> %.9f", h[i].step, h[i - 1].ropelength,
+                          h[i].ropelength);
+        put_back += more == 1 && !escaped;
+    }
+    ck_assert_int_ge(put_back, 1);
+    ck_assert_int_eq(tk_run_latest(run)->restarts, (int)ne + put_back);
     tk_run_free(&run);
     tk_curve_free(&c);
 }

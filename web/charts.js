@@ -56,7 +56,17 @@ export function drawHistory(svg, steps, mark = null) {
     if (mark != null && mark >= x0 && mark <= x1) {
         svg.append(el('line', { x1: sx(mark), x2: sx(mark), y1: T, y2: H - B, class: 'marker' }));
     }
-    const d = pts.map((s, i) => `${i ? 'L' : 'M'}${sx(s.step).toFixed(1)},${sy(s.ropelength).toFixed(1)}`).join('');
+    // Where the run took another curve (an escape's deformation of the best,
+    // or the best put back: `restarts` changes) the figures jump: the line
+    // breaks there and a dashed tick says why.
+    const jump = (i) => i > 0 && pts[i].restarts !== pts[i - 1].restarts;
+    for (let i = 1; i < pts.length; i++) {
+        if (!jump(i)) continue;
+        const tick = el('line', { x1: sx(pts[i].step), x2: sx(pts[i].step), y1: T, y2: H - B, class: 'restart' });
+        tick.append(el('title', {}, `step ${pts[i].step}: another curve (an escape, or the best so far put back)`));
+        svg.append(tick);
+    }
+    const d = pts.map((s, i) => `${i && !jump(i) ? 'L' : 'M'}${sx(s.step).toFixed(1)},${sy(s.ropelength).toFixed(1)}`).join('');
     svg.append(el('path', { d, class: 'curve' }));
     const last = pts[pts.length - 1];
     svg.append(el('circle', { cx: sx(last.step), cy: sy(last.ropelength), r: 3, fill: 'var(--accent)' }));

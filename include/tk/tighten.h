@@ -180,7 +180,10 @@ const char *tk_stop_reason_name(tk_stop_reason r);
       "worst constraint violation after the step / tau")                                     \
     X(corrections, INT, 0, 0, 0, "corrections", "Newton iterations after the step")         \
     X(vertices, SIZE, 0, 0, 0, "vertices", "of the curve")                                  \
-    X(escapes, INT, 0, 0, 0, "escapes", "escapes tried so far (tk_run_escapes)")
+    X(escapes, INT, 0, 0, 0, "escapes", "escapes tried so far (tk_run_escapes)")            \
+    X(restarts, INT, 0, 0, 0, "restarts",                                                   \
+      "times the curve was replaced by another: an escape's deformation of the best, or "   \
+      "the best put back (the figures jump where it changes)")
 
 typedef struct tk_step_report {
     TK_STEP_FIELDS(TK_FIELD_DECLARE)
@@ -307,7 +310,8 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out);
     X(step_size, REAL, 0, 0, 1e300, "step_size", "the last step's size")                     \
     X(escapes, INT, 0, 0, 1000, "escapes", "escapes tried")                                 \
     X(draws, LONG, 0, 0, 9e15, "draws", "numbers drawn from the escapes' random stream")    \
-    X(best_polish, INT, 0, 0, 1000, "best_polish", "the polishing level of the best curve")
+    X(best_polish, INT, 0, 0, 1000, "best_polish", "the polishing level of the best curve")  \
+    X(restarts, INT, 0, 0, 1e6, "restarts", "times the curve was replaced by another")
 
 typedef struct tk_resume {
     TK_RESUME_FIELDS(TK_FIELD_DECLARE)

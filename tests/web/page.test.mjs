@@ -334,6 +334,27 @@ test('selecting a job in the list shows it', async () => {
     assert.match(page.url(), new RegExp(`#job=${shared.trefoil}$`));
 });
 
+test('the chart breaks its line where the run took another curve', async () => {
+    // the page's own drawing code, on figures whose `restarts` changes twice
+    // (an escape's looser curve at step 3, the best put back at step 6)
+    const drawn = await page.evaluate(async () => {
+        const { drawHistory } = await import('/charts.js');
+        const svg = document.createElementNS('http://www.w3.org/2000/svg', 'svg');
+        const rope = [40, 35, 33, 60, 45, 38, 33, 32.9];
+        const restarts = [0, 0, 0, 1, 1, 1, 2, 2];
+        drawHistory(svg, rope.map((r, i) => ({ step: i, ropelength: r, restarts: restarts[i] })));
+        const d = svg.querySelector('path.curve').getAttribute('d');
+        return {
+            moves: (d.match(/M/g) || []).length,
+            lines: (d.match(/L/g) || []).length,
+            ticks: [...svg.querySelectorAll('line.restart')].map((l) => l.querySelector('title').textContent),
+        };
+    });
+    assert.equal(drawn.moves, 3, 'three pieces of line');
+    assert.equal(drawn.lines, 5, 'joined within each piece');
+    assert.deepEqual(drawn.ticks.map((t) => t.split(':')[0]), ['step 3', 'step 6']);
+});
+
 test('no script errors', () => {
     assert.deepEqual(pageErrors, []);
     assert.deepEqual(consoleErrors.filter((e) => !/status of 4\d\d/.test(e)), []);
