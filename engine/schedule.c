@@ -57,13 +57,12 @@
  * kinks active a step (median) against 45.  But like a strut, an active
  * kink is held at first order whatever its slack, and 0.1 of it held the
  * disguised figure-eight of bench/starts (resolution 5, 120 s) at 44.45
- * in two runs, where the struts' tolerance gave 42.10995 and 0.01
- * 42.10928.  The trefoil-2400 of tests/data tightened again for 150 s:
- * 32.743816 with the struts' tolerance (median step 1.9e-5), 32.743807
- * with 0.01 (2.7e-3), 32.743804 with 0.1 (5.4e-3).  The last figure
- * of the figure-eight was not the committed engine's: with 0.01 that
- * start crawled from 55.17 (step 2,000) to 43.72 in 120 s (the bench:
- * 44.474, never judged converged, no escape), its 14 to 16 kinks held;
+ * in two runs, where the struts' tolerance gave 42.10995.  The
+ * trefoil-2400 of tests/data tightened again for 150 s: 32.743816 with
+ * the struts' tolerance (median step 1.9e-5), 32.743807 with 0.01
+ * (2.7e-3), 32.743804 with 0.1 (5.4e-3).  With 0.01 the figure-eight
+ * crawled too, its 14 to 16 kinks held: from 55.17 (step 2,000) to 43.72
+ * in 120 s (the bench: 44.474, never judged converged, no escape), where
  * with the struts' tolerance it ended at 42.10985 after 5 escapes.  So
  * the kinks' own tolerance holds only where they are stiffer than
  * KINK_STIFFNESS_FROM times a strut (edges under 0.022 diameters,
