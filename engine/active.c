@@ -320,8 +320,9 @@ static int compare_kink_vertices(const void *pa, const void *pb)
 
 /* One per vertex at the curvature bound, with its radius (equation 3)
  * and the sum of its constraints' forces: the kinks that hold the motion
- * or are within the struts' active tolerance (the kinks' own is wider,
- * tk_tolerance_kink, and holds vertices up to 1% from the bound). */
+ * or are within the struts' active tolerance (on fine polygons the
+ * kinks' own is wider, tk_tolerance_kink, and holds vertices up to 1%
+ * from the bound). */
 int tk_active_report(tk_run *r, tk_error *err)
 {
     const tk_constraints *set = &r->active.set;
