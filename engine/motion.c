@@ -95,6 +95,34 @@ int tk_motion_fit(tk_run *r, size_t vertices, tk_error *err)
  * lets a step that needs no halving raise the weight again, towards
  * fewer pivots a round. */
 #define MOTION_PROXIMAL_GROW 2.0
+/* Where the weight shrinks, its last rounds are the dear ones: near a
+ * critical point with many dependent contacts the problem at 1e-8 and
+ * less is all but the plain one, and block pivoting gives way to the
+ * fallback (tk/nnls.h), a thousand pivots and more a round.  There, where
+ * the resolved motion is below MOTION_CRITICAL of the unresolved one
+ * (|v| < MOTION_CRITICAL |u|: the curve is critical to within that), a
+ * round that needed the fallback ends the rounds when its motion
+ * descends at half the rate of the exact one or better (term below
+ * MOTION_PROXIMAL_ENOUGH of |v|^2: the slope along v is -|v|^2 + term),
+ * and so does a round whose next weight would be at or below the
+ * largest that needed it lately (run.h: motion.dear, which fades by
+ * MOTION_DEAR_FADE a solve, so a deeper round is tried again some 20
+ * solves later).  A tight trefoil of 600 vertices tightened again
+ * (bench/steps --curve t600.vect --steps 150; its active set at the
+ * unpolished tolerance, 3,000 struts) took 4,485 ms a step (mean;
+ * median 4,076) and 146 factorisations, and now 659 ms (431) and 73;
+ * `tighten` on it for 150 s made 27 steps and ended at 32.7460107, and
+ * now 175 steps and 32.745988.  Without the bound on |v| the steps took
+ * 187 ms, but the early rounds also acted in the flow far from critical
+ * points, where the motion's lost precision cost progress: catalogue 3.1
+ * at 2,400 vertices (600 s) left its 600-vertex level after 27 s at
+ * 32.7528 instead of 49 s at 32.7516, and did not reach 32.7437 in 600 s
+ * (204 s).  No step of that run reported a residual below 3e-3; with the
+ * bound its 4,318 steps in 600 s, and every trajectory of
+ * tests/data/histories.txt, are as they were. */
+#define MOTION_PROXIMAL_ENOUGH 0.5
+#define MOTION_DEAR_FADE 0.9
+#define MOTION_CRITICAL 1e-3
 
 /* out = A x (3V entries). */
 static void multiply(const cholmod_sparse *a, const double *x, double *out, size_t rows)
@@ -184,8 +212,11 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
     rc = tk_active_matrix(r, c, set, &a, err);
     if (rc)
         return rc;
-    for (size_t i = 0; i < n3; i++)
+    double target2 = 0.0; /* |b|^2, b = -u */
+    for (size_t i = 0; i < n3; i++) {
         work[i] = -motion[i];
+        target2 += work[i] * work[i];
+    }
     tk_nnls_report nr;
     tk_nnls_options nopt = TK_NNLS_OPTIONS_INIT;
     nopt.warm_start = true;
@@ -197,17 +228,24 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
                        ? fmin(MOTION_PROXIMAL_GROW * r->motion.weight, MOTION_PROXIMAL_KEPT)
                        : MOTION_PROXIMAL_KEPT;
     int most = cheap ? MOTION_PROXIMAL_KEPT_ROUNDS : MOTION_PROXIMAL_ROUNDS;
-    double used = nopt.proximal;
+    double used = nopt.proximal, dear = 0.0;
     for (int round = 0; !rc && round < most; round++) {
         used = nopt.proximal;
         rc = tk_nnls_solve(r->shared.nnls, a, work, r->motion.x, &nopt, &nr, err);
         r->motion.nnls_iterations += nr.iterations;
         r->motion.factorisations += nr.factorisations;
         r->motion.kept = !rc && nr.kept;
-        double term = fabs(nr.proximal_term);
-        if (rc || !(term > MOTION_PROXIMAL_SHARE * nr.residual * nr.residual))
+        double term = fabs(nr.proximal_term), res2 = nr.residual * nr.residual;
+        bool shrinking = !large || !nr.kept;
+        if (!rc && shrinking && nr.used_fallback)
+            dear = fmax(dear, used);
+        if (rc || !(term > MOTION_PROXIMAL_SHARE * res2))
             break;
-        if (!large || !nr.kept)
+        if (shrinking && term < MOTION_PROXIMAL_ENOUGH * res2 &&
+            res2 < MOTION_CRITICAL * MOTION_CRITICAL * target2 &&
+            (nr.used_fallback || MOTION_PROXIMAL_SHRINK * used <= r->motion.dear))
+            break;
+        if (shrinking)
             nopt.proximal *= MOTION_PROXIMAL_SHRINK;
         else if (term > MOTION_PROXIMAL_SLOW * last)
             nopt.proximal *= MOTION_PROXIMAL_HALVE;
@@ -215,6 +253,7 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
         last = term;
     }
     r->motion.weight = cheap && !rc ? used : 0.0;
+    r->motion.dear = fmax(dear, MOTION_DEAR_FADE * r->motion.dear);
     r->motion.nnls_seconds += tk_clock() - t0;
     r->motion.nnls_solves++;
     if (!rc) {

@@ -96,6 +96,8 @@ struct tk_run {
         bool kept;       /* the last solve's factor is kept (tk/nnls.h) */
         double weight;   /* the proximal weight the last such solve ended
                             at (0: none) */
+        double dear;     /* shrinking weights: the largest weight at which a
+                            round lately needed the NNLS's fallback (0: none) */
         double nnls_seconds;
         long nnls_solves, nnls_iterations, factorisations;
     } motion;

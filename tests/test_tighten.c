@@ -654,6 +654,54 @@ START_TEST(a_fine_tight_polygon_is_restored_in_place)
 }
 END_TEST
 
+START_TEST(a_tight_curve_tightened_again_steps_at_a_bounded_cost)
+{
+    /* tests/data/trefoil-600.vect: catalogue 3.1 tightened at 600
+     * vertices for 150 s (32.7460111; its run ended polished, with 1,040
+     * struts).  Tightened again from scratch its active tolerance is the
+     * unpolished one, which holds some 3,000 dependent struts on 1,800
+     * coordinates, and the proximal rounds' smallest weights needed the
+     * NNLS's fallback: 2,457 pivots and 175 factorisations a warm step
+     * (now 144 and 32).  The motion must still balance the gradient (the
+     * KKT residual) at a bounded count of pivots. */
+    tk_curve *c = NULL;
+    tk_error err;
+    ck_assert_msg(tk_vect_read_file("tests/data/trefoil-600.vect", NULL, &c, &err) == TK_OK,
+                  "%s", err.message);
+    tk_options o = TK_OPTIONS_INIT;
+    o.coarse_to_fine = false;
+    o.escapes = 0;
+    tk_run *run = NULL;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    double start = tk_run_latest(run)->ropelength;
+    /* the first step is cold: every contact is new to the NNLS */
+    ck_assert_int_eq(tk_run_step(run, &err), TK_OK);
+    tk_run_timing before, after;
+    tk_run_timing_get(run, &before);
+    const int warm = 8;
+    double worst_residual = 0.0;
+    for (int k = 0; k < warm; k++) {
+        ck_assert_int_eq(tk_run_step(run, &err), TK_OK);
+        const tk_step_report *s = tk_run_latest(run);
+        ck_assert_uint_ge(s->struts, 2500);
+        worst_residual = fmax(worst_residual, s->residual);
+    }
+    tk_run_timing_get(run, &after);
+    double pivots = (double)(after.nnls_iterations - before.nnls_iterations) / warm;
+    double factorisations = (double)(after.factorisations - before.factorisations) / warm;
+    double end = tk_run_latest(run)->ropelength;
+    printf("tight trefoil at 600 vertices again: %.1f pivots and %.1f factorisations a warm "
+           "step, residual at most %.3g, ropelength %.9f -> %.9f\n",
+           pivots, factorisations, worst_residual, start, end);
+    ck_assert_msg(pivots < 500.0, "%.1f pivots a step", pivots);
+    ck_assert_msg(worst_residual < 1e-2, "residual %.3g", worst_residual);
+    /* a critical point stays one: no step undoes the tightening */
+    ck_assert_msg(end < start * (1.0 + 1e-5), "%.9f -> %.9f", start, end);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(a_refined_tight_polygon_is_restored_without_rescaling)
 {
     if (quick() && tkt_skip("a_refined_tight_polygon_is_restored_without_rescaling", LONG_RUN))
@@ -1808,6 +1856,7 @@ int main(void)
     tcase_add_test(tc, recovery_restores_thousands_of_contacts_without_rescaling);
     tcase_add_test(tc, a_fine_start_is_set_up_with_the_tolerance_of_its_edges);
     tcase_add_test(tc, a_fine_tight_polygon_is_restored_in_place);
+    tcase_add_test(tc, a_tight_curve_tightened_again_steps_at_a_bounded_cost);
     tcase_add_test(tc, a_refined_tight_polygon_is_restored_without_rescaling);
     tcase_add_test(tc, a_loose_curve_is_kept_at_the_tube);
     tcase_add_test(tc, a_loose_start_keeps_its_final_count_through_escapes);
