@@ -663,7 +663,7 @@ START_TEST(a_tight_curve_tightened_again_steps_at_a_bounded_cost)
      * coordinates, and the proximal rounds' smallest weights needed the
      * NNLS's fallback: 2,457 pivots and 175 factorisations a warm step
      * (now 144 and 32).  The motion must still balance the gradient (the
-     * KKT residual) at a bounded count of pivots. */
+     * KKT residual) at a bounded count of pivots, and the run polish. */
     tk_curve *c = NULL;
     tk_error err;
     ck_assert_msg(tk_vect_read_file("tests/data/trefoil-600.vect", NULL, &c, &err) == TK_OK,
@@ -697,6 +697,23 @@ START_TEST(a_tight_curve_tightened_again_steps_at_a_bounded_cost)
     ck_assert_msg(worst_residual < 1e-2, "residual %.3g", worst_residual);
     /* a critical point stays one: no step undoes the tightening */
     ck_assert_msg(end < start * (1.0 + 1e-5), "%.9f -> %.9f", start, end);
+    /* Critical at its tolerance, the curve polishes without waiting for
+     * the window of steps over which the ropelength all but stops falling
+     * (733 steps at 600 vertices): 20 steps with residuals below 1e-3
+     * (here from the first), then a third of the tolerance and fewer
+     * struts (1,741 against 3,001). */
+    long steps = 40;
+    while (tk_run_latest(run)->step < steps)
+        ck_assert_int_eq(tk_run_step(run, &err), TK_OK);
+    tk_resume at;
+    tk_run_resume_point(run, &at);
+    const tk_step_report *last = tk_run_latest(run);
+    printf("  after %ld steps: polishing level %d, %zu struts, ropelength %.9f\n", last->step,
+           at.polish_level, last->struts, last->ropelength);
+    ck_assert_int_ge(at.polish_level, 1);
+    ck_assert_uint_lt(last->struts, 2000);
+    ck_assert_msg(last->ropelength < start * (1.0 + 1e-5), "%.9f -> %.9f", start,
+                  last->ropelength);
     tk_run_free(&run);
     tk_curve_free(&c);
 }
