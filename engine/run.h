@@ -325,6 +325,9 @@ void tk_recovery_free(tk_run *r);
  * than a set fraction over a window of steps, or by less than a larger
  * one for a set share of the budget (a crawl). */
 bool tk_escape_converged(const tk_run *r);
+/* After each step's figures, with escapes: the curve on the final polygon
+ * is kept if it is the best so far, and the try under way's lowest noted. */
+void tk_escape_after_step(tk_run *r);
 /* Asks for an escape before the next step when tries and budget remain
  * (the attempt that converged is noted); false when none is left. */
 bool tk_escape_ask(tk_run *r);

@@ -438,6 +438,7 @@ static int step(tk_run *r, tk_error *err)
         r->life.stop = TK_STOP_FAILED;
         return rc;
     }
+    tk_escape_after_step(r);
     if (r->life.progress && r->life.progress(&r->life.latest, r->life.user) != 0)
         tk_run_cancel(r);
     r->life.stop = TK_STOP_NONE;

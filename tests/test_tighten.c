@@ -1300,6 +1300,16 @@ START_TEST(escapes_keep_the_best_and_repeat)
             ck_assert(end->ropelength <= e[k].reached * (1.0 + 1e-12));
         ck_assert_int_eq(e[k].improved, e[k].reached < e[k].from);
     }
+    /* the curve returned is the lowest of every step's (the run has one
+     * polygon), not only of those where a try was judged */
+    size_t nh = 0;
+    const tk_step_report *h = tk_run_history(a, &nh);
+    double lowest = INFINITY;
+    for (size_t i = 0; i < nh; i++)
+        lowest = fmin(lowest, h[i].ropelength);
+    printf("returned %.9f, lowest of %zu steps %.9f\n", end->ropelength, nh, lowest);
+    ck_assert_msg(end->ropelength <= lowest * (1.0 + 1e-12), "%.12f above %.12f",
+                  end->ropelength, lowest);
     /* measured independently: feasible, at the start's vertex count */
     const tk_curve *c = tk_run_curve(a);
     ck_assert_uint_eq(c->nvert, 80);
@@ -1847,6 +1857,48 @@ START_TEST(the_last_fifth_of_the_budget_polishes_the_best)
 }
 END_TEST
 
+/* Once the tries are spent the best curve is put back and polished, and
+ * not put back again until the run ends: judged again each window, a
+ * polish that stood a little above the best (a step's rise) was put back
+ * to it and replayed the same steps (T(2,3) at 60 vertices, one escape:
+ * put back 24 times in 12,000 steps).  Every step's curve counts for the
+ * best, so none is lost by going on. */
+START_TEST(a_best_put_back_is_polished_not_replayed)
+{
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 60, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.escapes = 1;
+    o.max_steps = 6000; /* the escape after step 911, the best put back at 2,052 */
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_msg(tk_run_until(run, NULL, &err) == TK_OK, "%s", err.message);
+    size_t nh = 0, ne = 0;
+    const tk_step_report *h = tk_run_history(run, &nh);
+    (void)tk_run_escapes(run, &ne);
+    const tk_step_report *end = tk_run_latest(run);
+    double lowest = INFINITY;
+    for (size_t i = 0; i < nh; i++)
+        lowest = fmin(lowest, h[i].ropelength);
+    printf("T(2,3), 60 vertices, %ld steps: %zu escape, %d restarts; ends at %.9f, the lowest "
+           "step %.9f\n", end->step, ne, end->restarts, end->ropelength, lowest);
+    ck_assert_uint_eq(ne, 1);
+    /* the escape, the best put back, and at most once more at the end */
+    ck_assert_int_le(end->restarts, (int)ne + 2);
+    ck_assert_msg(end->ropelength <= lowest * (1.0 + 1e-12), "%.12f above %.12f",
+                  end->ropelength, lowest);
+    /* measured independently: the curve returned is the one reported */
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(tk_run_curve(run), NULL, &m, NULL), TK_OK);
+    ck_assert(fabs(m.ropelength - end->ropelength) <= 1e-9 * end->ropelength);
+    ck_assert(m.thickness >= 1.0 - 1e-5);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("tighten");
@@ -1863,6 +1915,7 @@ int main(void)
     tcase_add_test(tc, a_resumed_run_keeps_its_escapes);
     tcase_add_test(tc, a_crawling_run_escapes_after_a_fifth_of_its_budget);
     tcase_add_test(tc, the_last_fifth_of_the_budget_polishes_the_best);
+    tcase_add_test(tc, a_best_put_back_is_polished_not_replayed);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
     tcase_add_test(tc, vertices_option_ends_at_exactly_that_count);
