@@ -26,6 +26,25 @@
  * 3e-3); a curve critical at its tolerance goes no further at it. */
 #define POLISH_CRITICAL 1e-3
 #define POLISH_CRITICAL_STEPS 20
+/* On the final polygon, where the window (below) is at least
+ * POLISH_RATE_FROM times POLISH_WINDOW steps, a level also ends when the
+ * fall over its last POLISH_WINDOW steps, at that rate over the whole
+ * window, is below the bound.  The window is 2,933 steps at 2,400
+ * vertices, and the ropelength of a curve near tight falls by less than
+ * a tenth of the bound over it: the test data's tight trefoil tightened
+ * again (tests/data/trefoil-2400.vect; residuals about 1e-2, so never
+ * critical) fell by 8.5e-7 in its first 300 steps, and waited 2,933
+ * steps of about 500 ms at a level whose 12,000 struts the third level
+ * brings to 2,800 (62 ms a step).  With the rate its 240 s reached
+ * 32.743705 in 1,288 steps (52 ms a step from step 600) against
+ * 32.743787 in 466; catalogue 3.1 at `--vertices 2400` for 600 s
+ * reached 32.7432766 against 32.7436118 (9,005 steps on the final
+ * polygon against 942).  Not on the coarse levels: there a level that
+ * stalls moves on to the next polygon, and the same run left them at
+ * 22 s instead of 154 s, looser, and ended at 32.74377.  The atlas's
+ * counts (200 to 600 vertices, windows of 320 to 380 steps) keep the
+ * whole window. */
+#define POLISH_RATE_FROM 2
 /* The windows of steps that judge whether the ropelength has stopped
  * falling (the polish watch here, convergence for an escape) are counted
  * for a polygon whose mean edge is WINDOW_EDGE diameters (resolution 5)
@@ -654,16 +673,26 @@ static bool critical_since(const tk_run *r, size_t from)
     return true;
 }
 
+/* Whether the ropelength has stopped falling at the current level: by
+ * less than the bound over the window, or at a rate that makes less over
+ * it (POLISH_RATE_FROM). */
+static bool stalled(const tk_run *r)
+{
+    size_t from = r->schedule.polish_from, window = tk_schedule_window(r, POLISH_WINDOW);
+    double fall, bound = POLISH_CHANGE * polish_scale(r);
+    if (tk_history_fall(r, from, window, &fall) && fall < bound)
+        return true;
+    return tk_schedule_final(r) && window >= POLISH_RATE_FROM * POLISH_WINDOW &&
+           tk_history_fall(r, from, POLISH_WINDOW, &fall) &&
+           fall * (double)window / POLISH_WINDOW < bound;
+}
+
 /* Judged on the history before this step's figures, after its motion and
  * before its error recovery (which then works to the new tolerances). */
 void tk_schedule_watch(tk_run *r)
 {
-    double fall;
     if (r->schedule.polish_level < POLISH_LEVELS &&
-        ((tk_history_fall(r, r->schedule.polish_from, tk_schedule_window(r, POLISH_WINDOW),
-                          &fall) &&
-          fall < POLISH_CHANGE * polish_scale(r)) ||
-         critical_since(r, r->schedule.polish_from)) &&
+        (stalled(r) || critical_since(r, r->schedule.polish_from)) &&
         !tk_schedule_move_on(r)) {
         r->schedule.polish_level++;
         r->schedule.polish_from = r->life.nhistory;

@@ -654,6 +654,55 @@ START_TEST(a_fine_tight_polygon_is_restored_in_place)
 }
 END_TEST
 
+START_TEST(a_fine_tight_curve_polishes_at_the_rate_of_its_fall)
+{
+    /* The tight 600-vertex trefoil resumed at polishing level 2, where its
+     * residual stays above the critical bound (1e-3): the ropelength falls
+     * by about 1e-10 a step, far less than the level's bound (1e-4 / 9)
+     * over its window of 733 steps, and the level ends after its first
+     * 200 steps at that rate instead of waiting for the whole window. */
+    tk_curve *c = NULL;
+    tk_error err;
+    ck_assert_msg(tk_vect_read_file("tests/data/trefoil-600.vect", NULL, &c, &err) == TK_OK,
+                  "%s", err.message);
+    tk_options o = TK_OPTIONS_INIT;
+    o.coarse_to_fine = false;
+    o.escapes = 0;
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, &err), TK_OK);
+    tk_resume at;
+    memset(&at, 0, sizeof at);
+    at.start_ropelength = m.ropelength;
+    at.polish_level = 2;
+    tk_run *run = NULL;
+    ck_assert_msg(tk_run_resume(c, &o, &at, NULL, NULL, NULL, &run, &err) == TK_OK, "%s",
+                  err.message);
+    double start = tk_run_latest(run)->ropelength;
+    const long steps = 215;
+    long above = -1; /* the last step with a residual of 1e-3 or more */
+    tk_resume now = at;
+    while (tk_run_latest(run)->step < steps && now.polish_level == 2) {
+        ck_assert_int_eq(tk_run_step(run, &err), TK_OK);
+        const tk_step_report *s = tk_run_latest(run);
+        if (!(s->residual < 1e-3))
+            above = s->step;
+        tk_run_resume_point(run, &now);
+    }
+    const tk_step_report *last = tk_run_latest(run);
+    printf("tight trefoil at 600 vertices from polishing level 2: level %d at step %ld, "
+           "a residual of 1e-3 or more last at step %ld, ropelength %.9f -> %.9f\n",
+           now.polish_level, last->step, above, start, last->ropelength);
+    ck_assert_int_eq(now.polish_level, 3);
+    ck_assert_int_ge(last->step, 200);
+    /* not critical (20 steps below 1e-3): the fall's rate ended the level */
+    ck_assert_int_ge(above, last->step - 20);
+    ck_assert_msg(last->ropelength < start * (1.0 + 1e-6), "%.9f -> %.9f", start,
+                  last->ropelength);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(a_tight_curve_tightened_again_steps_at_a_bounded_cost)
 {
     /* tests/data/trefoil-600.vect: catalogue 3.1 tightened at 600
@@ -1927,6 +1976,7 @@ int main(void)
     tcase_add_test(tc, a_fine_start_is_set_up_with_the_tolerance_of_its_edges);
     tcase_add_test(tc, a_fine_tight_polygon_is_restored_in_place);
     tcase_add_test(tc, a_tight_curve_tightened_again_steps_at_a_bounded_cost);
+    tcase_add_test(tc, a_fine_tight_curve_polishes_at_the_rate_of_its_fall);
     tcase_add_test(tc, a_refined_tight_polygon_is_restored_without_rescaling);
     tcase_add_test(tc, a_loose_curve_is_kept_at_the_tube);
     tcase_add_test(tc, a_loose_start_keeps_its_final_count_through_escapes);
