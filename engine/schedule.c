@@ -36,8 +36,8 @@
  * critical) fell by 8.5e-7 in its first 300 steps, and waited 2,933
  * steps of about 500 ms at a level whose 12,000 struts the third level
  * brings to 2,800 (62 ms a step).  With the rate its 240 s reached
- * 32.743705 in 1,288 steps (52 ms a step from step 600) against
- * 32.743787 in 466; catalogue 3.1 at `--vertices 2400` for 600 s
+ * 32.743705 and 32.743714 (two runs; 52 and 66 ms a step from step 600)
+ * against 32.743787; catalogue 3.1 at `--vertices 2400` for 600 s
  * reached 32.7432766 against 32.7436118 (9,005 steps on the final
  * polygon against 942).  Not on the coarse levels: there a level that
  * stalls moves on to the next polygon, and the same run left them at
