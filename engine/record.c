@@ -15,6 +15,8 @@
     TK_FIELD_ROW(tk_step_report, fld, fld, kind, 0, -INFINITY, INFINITY, nm, hlp),
 #define RESUME_ROW(fld, kind, dflt, lo, hi, nm, hlp)                                     \
     TK_FIELD_ROW(tk_resume, fld, fld, kind, dflt, lo, hi, nm, hlp),
+#define RECOVERY_ROW(fld, kind, dflt, lo, hi, nm, hlp)                                   \
+    TK_FIELD_ROW(tk_run_timing, fld, fld, kind, dflt, lo, hi, nm, hlp),
 
 const tk_field tk_option_fields[] = {TK_OPTION_FIELDS(OPTION_ROW)};
 const size_t tk_option_nfields = sizeof tk_option_fields / sizeof tk_option_fields[0];
@@ -22,6 +24,8 @@ const tk_field tk_step_fields[] = {TK_STEP_FIELDS(STEP_ROW)};
 const size_t tk_step_nfields = sizeof tk_step_fields / sizeof tk_step_fields[0];
 const tk_field tk_resume_fields[] = {TK_RESUME_FIELDS(RESUME_ROW)};
 const size_t tk_resume_nfields = sizeof tk_resume_fields / sizeof tk_resume_fields[0];
+const tk_field tk_recovery_fields[] = {TK_RECOVERY_FIELDS(RECOVERY_ROW)};
+const size_t tk_recovery_nfields = sizeof tk_recovery_fields / sizeof tk_recovery_fields[0];
 
 const tk_field *tk_field_find(const tk_field *table, size_t n, const char *name)
 {

@@ -46,6 +46,20 @@ START_TEST(tables_describe_their_structs)
         ck_assert(tk_field_get(&tk_step_fields[i], &s) == (double)(i + 1));
     ck_assert_int_eq(s.step, 1);
     ck_assert_int_eq(s.restarts, (int)tk_step_nfields); /* the last field */
+    /* the recovery counts are fields of the run's timing, each its own */
+    tk_run_timing t;
+    memset(&t, 0, sizeof t);
+    for (size_t i = 0; i < tk_recovery_nfields; i++) {
+        const tk_field *f = &tk_recovery_fields[i];
+        ck_assert(f->offset < sizeof t && f->name);
+        ck_assert_int_eq(tk_field_set(f, &t, (double)(i + 1), NULL), TK_OK);
+    }
+    ck_assert_int_eq(t.undone_steps, 1);
+    ck_assert_int_eq(t.rescales, 2);
+    ck_assert(t.largest_rescale == 3.0);
+    ck_assert_int_eq(t.bent_corrections, 4);
+    ck_assert_int_eq(t.length_steps, 5);
+    ck_assert(t.search == 0.0 && t.total == 0.0 && t.factorisations == 0);
 }
 END_TEST
 

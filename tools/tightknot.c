@@ -231,9 +231,12 @@ static const char tighten_help_end[] =
     "                          steps, stop_reason, options (the run options as\n"
     "                          used), invariants: {start, result}, the knot or\n"
     "                          link type of the input and of the result, as in\n"
-    "                          'tightknot info --json', and escapes: [{step,\n"
+    "                          'tightknot info --json', escapes: [{step,\n"
     "                          from, amplitude, reached, improved}], one per\n"
-    "                          escape tried\n"
+    "                          escape tried, and recovery: {undone_steps,\n"
+    "                          rescales, largest_rescale, bent_corrections,\n"
+    "                          length_steps}, error recovery's last resorts\n"
+    "                          and the steps judged by their length alone\n"
     "  -h, --help              show this help\n"
     "\n"
     "A progress line goes to standard error when it is a terminal.  The\n"
@@ -887,6 +890,10 @@ static int cmd_tighten(int argc, char **argv)
         size_t ne = 0;
         const tk_escape *e = tk_run_escapes(run, &ne);
         json_object_set_new(o, "escapes", tk_json_escapes(e, ne));
+        tk_run_timing t;
+        tk_run_timing_get(run, &t);
+        json_object_set_new(o, "recovery",
+                            tk_json_record(tk_recovery_fields, tk_recovery_nfields, &t));
         if (print_json(o) != EXIT_OK)
             status = EXIT_INPUT;
     } else {

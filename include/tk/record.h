@@ -1,7 +1,7 @@
 /* tightknot: the fields of a record, by name.
  *
- * The run options, the step report and a run's resume point are each
- * written down once, as an
+ * The run options, the step report, a run's resume point and its
+ * recovery counts are each written down once, as an
  * X-macro table (tk/tighten.h).  This module turns a table into field
  * descriptors (name, kind, place in the struct, domain, help), so that
  * every mapping of a record (the command line's options and --help, HTTP
@@ -48,6 +48,9 @@ extern const tk_field tk_step_fields[];
 extern const size_t tk_step_nfields;
 extern const tk_field tk_resume_fields[];
 extern const size_t tk_resume_nfields;
+/* the recovery fields of tk_run_timing (TK_RECOVERY_FIELDS) */
+extern const tk_field tk_recovery_fields[];
+extern const size_t tk_recovery_nfields;
 
 /* The field called `name` (its user name), or NULL. */
 const tk_field *tk_field_find(const tk_field *table, size_t n, const char *name);

@@ -253,6 +253,25 @@ const tk_invariants *tk_run_type_latest(const tk_run *r);
  * resampling); the two rooms' totals include the operations they called.
  * So search + matrix + nnls + checks <= total and stepping + recovery <=
  * total. */
+/* Error recovery's last resorts and the step control's fallback, counted
+ * over a run (fields of tk_run_timing; `tighten --json` reports them as
+ * "recovery").  Rows as for the options. */
+#define TK_RECOVERY_FIELDS(X)                                                                \
+    X(undone_steps, LONG, 0, 0, 9e15, "undone_steps",                                        \
+      "steps undone and taken again shorter because Newton steps could not restore the "     \
+      "thickness (section 4.6)")                                                             \
+    X(rescales, LONG, 0, 0, 9e15, "rescales",                                                \
+      "rescalings of the whole curve about its centroid, autoscale not counted")             \
+    X(largest_rescale, REAL, 0, 0, 1e300, "largest_rescale",                                 \
+      "the largest of their factors, minus 1")                                               \
+    X(bent_corrections, LONG, 0, 0, 9e15, "bent_corrections",                                \
+      "corrections whose Newton and inequality steps could not restore the thickness and "   \
+      "went on to steps weighed by their bending (section 4.6 on fine polygons)")            \
+    X(length_steps, LONG, 0, 0, 9e15, "length_steps",                                        \
+      "steps judged by their length alone: the length over the thickness their violation "   \
+      "leaves rose at first order in the step size (section 4.5; the NNLS answer is not "    \
+      "exact enough for the stiff kinks of a fine polygon)")
+
 typedef struct tk_run_timing {
     double search;       /* active sets: struts and kinks found with the tree */
     double matrix;       /* rigidity matrices built (equations 6, 7) */
@@ -267,19 +286,7 @@ typedef struct tk_run_timing {
     long nnls_solves, nnls_iterations, factorisations;
     double invariants;   /* the knot type computed and compared (included
                             in total) */
-    /* Error recovery's last resorts: steps undone and taken again shorter
-     * because Newton steps could not restore the thickness, and rescalings
-     * of the whole curve about its centroid (not counting autoscale) with
-     * the largest factor - 1; and the corrections whose Newton and
-     * inequality steps could not restore it, and which went on to steps
-     * weighed by their bending as well (section 4.6 on fine polygons). */
-    long undone_steps, rescales, bent_corrections;
-    double largest_rescale;
-    /* Steps judged by their length alone: the length over the thickness
-     * their violation leaves rose at first order in the step size, so no
-     * shorter step lowered it (section 4.5's step control; the NNLS answer
-     * is not exact enough for the stiff kinks of a fine polygon). */
-    long length_steps;
+    TK_RECOVERY_FIELDS(TK_FIELD_DECLARE)
 } tk_run_timing;
 
 void tk_run_timing_get(const tk_run *r, tk_run_timing *out);
