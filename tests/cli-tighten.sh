@@ -78,13 +78,16 @@ check $? "the summary's recovery line: $(grep recovery "$tmp/summary.txt")"
 check $? "tighten (text, 1,000 steps) exits 0: $(cat "$tmp/err")"
 "$tk" tighten "$tmp/trefoil.vect" --autoscale --steps 1000 --json >"$tmp/long.json" 2>"$tmp/err"
 check $? "tighten --json (1,000 steps) exits 0: $(cat "$tmp/err")"
-judged=$(sed -n 's/^  step control: \([0-9]*\) steps* judged by the length alone.*/\1/p' "$tmp/long.txt")
-[ -n "$judged" ] && [ "$judged" -gt 0 ] && [ "$(value length_steps "$tmp/long.json")" = "$judged" ]
-check $? "--json's length_steps $(value length_steps "$tmp/long.json") is the summary's ${judged:-none}"
+judged=$(sed -n 's/^  step control: \([0-9]*\) steps* judged by the length alone.*/\1/p' \
+    "$tmp/long.txt")
+given=$(value length_steps "$tmp/long.json")
+[ -n "$judged" ] && [ "$judged" -gt 0 ] && [ "$given" = "$judged" ]
+check $? "--json's length_steps $given is the summary's ${judged:-none}"
 said=$(sed -n 's/^  recovery: \([0-9]*\) steps undone and taken shorter, \([0-9]*\) rescales.*/\1 \2/p' \
     "$tmp/long.txt")
-[ -n "$said" ] && [ "$(value undone_steps "$tmp/long.json") $(value rescales "$tmp/long.json")" = "$said" ]
-check $? "--json's undone_steps and rescales are the summary's ${said:-none}"
+given="$(value undone_steps "$tmp/long.json") $(value rescales "$tmp/long.json")"
+[ -n "$said" ] && [ "$given" = "$said" ]
+check $? "--json's undone_steps and rescales ($given) are the summary's ${said:-none}"
 
 # --re-resolve keeps the resolution as the knot tightens: fewer vertices
 # at the end than at the start, about resolution * ropelength of them

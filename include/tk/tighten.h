@@ -246,13 +246,6 @@ const tk_escape *tk_run_escapes(const tk_run *r, size_t *count);
 const tk_invariants *tk_run_type_start(const tk_run *r);
 const tk_invariants *tk_run_type_latest(const tk_run *r);
 
-/* Where a run's wall time went, in seconds.  The first four are the
- * operations every step repeats, wherever in the flow they happen;
- * `total` is all of tk_run_new and tk_run_step (the rest of it is the
- * motion, measuring and recording the figures, and the schedule's
- * resampling); the two rooms' totals include the operations they called.
- * So search + matrix + nnls + checks <= total and stepping + recovery <=
- * total. */
 /* Error recovery's last resorts and the step control's fallback, counted
  * over a run (fields of tk_run_timing; `tighten --json` reports them as
  * "recovery").  Rows as for the options. */
@@ -272,6 +265,13 @@ const tk_invariants *tk_run_type_latest(const tk_run *r);
       "leaves rose at first order in the step size (section 4.5; the NNLS answer is not "    \
       "exact enough for the stiff kinks of a fine polygon)")
 
+/* Where a run's wall time went, in seconds.  The first four are the
+ * operations every step repeats, wherever in the flow they happen;
+ * `total` is all of tk_run_new and tk_run_step (the rest of it is the
+ * motion, measuring and recording the figures, and the schedule's
+ * resampling); the two rooms' totals include the operations they called.
+ * So search + matrix + nnls + checks <= total and stepping + recovery <=
+ * total. */
 typedef struct tk_run_timing {
     double search;       /* active sets: struts and kinks found with the tree */
     double matrix;       /* rigidity matrices built (equations 6, 7) */
