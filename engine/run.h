@@ -363,8 +363,9 @@ void tk_schedule_resume_point(const tk_run *r, tk_resume *out);
 int tk_schedule_fit(tk_run *r, tk_error *err);
 /* The run's curve replaced by `curve` (taken over): with `coarse` the
  * schedule starts again from its coarsest level (the curve resampled to
- * it), else the curve keeps its vertices and the polishing level is
- * `polish`; made feasible by scaling, type-checked. */
+ * it), else `curve` is on the final polygon (the escapes' best): it keeps
+ * its vertices, the schedule is at the final level and the polishing
+ * level is `polish`; made feasible by scaling, type-checked. */
 int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_error *err);
 /* The fraction of the step or time budget spent (0 without one). */
 double tk_schedule_spent(const tk_run *r);

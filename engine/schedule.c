@@ -586,6 +586,15 @@ int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_
         r->schedule.coarse_level = r->schedule.coarse_levels;
         count = level_count(r, reference_ropelength(r));
     }
+    /* The best curve put back is on the final polygon, whatever level the
+     * try it replaces had reached: left at the try's, catalogue 3.1 at
+     * 2,400 vertices (600 s), whose try was on its 600-vertex level when
+     * the reserve began, polished the best from 32.7433009 to 32.743291
+     * without noting it (the escapes note the final polygon only), then
+     * took the stall for a coarse level's and went on to 1,200 vertices,
+     * and ended with the best unpolished. */
+    if (!coarse)
+        r->schedule.coarse_level = 0;
     tk_measure m;
     int rc = measure(curve, &m, err);
     if (rc)

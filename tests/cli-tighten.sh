@@ -89,6 +89,28 @@ given="$(value undone_steps "$tmp/long.json") $(value rescales "$tmp/long.json")
 [ -n "$said" ] && [ "$given" = "$said" ]
 check $? "--json's undone_steps and rescales ($given) are the summary's ${said:-none}"
 
+# An escape's try still on a coarse level when the last fifth of the
+# budget begins gives way to the best curve, which is on the final
+# polygon: the run stays there, and the polish that follows is kept.
+"$tk" tighten "$tmp/trefoil.vect" --autoscale --resolution 5 --steps 3000 --json \
+    --log "$tmp/reserve.tsv" >"$tmp/reserve.json" 2>"$tmp/err"
+check $? "tighten --steps 3000 with escapes exits 0: $(cat "$tmp/err")"
+# the put-back: restarts (column 16) up by one, vertices (14) from fewer
+# than the final count to it; then the rows after it off the final count
+awk -F'\t' 'NR > 1 { v[NR] = $14; r[NR] = $16; p[NR] = $3; if ($14 > final) final = $14; n = NR }
+    END { for (i = 3; i <= n; i++)
+              if (!at && r[i] == r[i - 1] + 1 && v[i - 1] < final && v[i] == final) at = i
+          for (i = at + 1; at && i <= n; i++) off += v[i] != final
+          printf "%d %d %.17g\n", at ? at - 2 : -1, off, at ? p[at] : 0 }' \
+    "$tmp/reserve.tsv" >"$tmp/putback"
+read -r putback off from <"$tmp/putback"
+[ "$putback" -ge 2400 ]
+check $? "a try on a coarse level gave way to the best at the reserve (step $putback, want >= 2400)"
+[ "$off" -eq 0 ]
+check $? "the best put back stays on the final polygon ($off rows left it)"
+awk -v a="$(value ropelength "$tmp/reserve.json")" -v b="$from" 'BEGIN { exit !(a < b) }'
+check $? "the polish of the best is kept: $(value ropelength "$tmp/reserve.json") < $from"
+
 # --re-resolve keeps the resolution as the knot tightens: fewer vertices
 # at the end than at the start, about resolution * ropelength of them
 "$tk" tighten "$tmp/trefoil.vect" --autoscale --resolution 5 --re-resolve 0.05 --steps 300 \
