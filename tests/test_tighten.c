@@ -29,6 +29,28 @@ static bool quick(void)
     return q && *q && strcmp(q, "0") != 0;
 }
 
+/* A curve of tests/data (the test fails when it cannot be read). */
+static tk_curve *test_data(const char *name)
+{
+    char path[256];
+    snprintf(path, sizeof path, "tests/data/%s", name);
+    tk_curve *c = NULL;
+    tk_error err;
+    ck_assert_msg(tk_vect_read_file(path, NULL, &c, &err) == TK_OK, "%s", err.message);
+    return c;
+}
+
+/* The lowest ropelength of every step a run has recorded; *steps gets
+ * their count. */
+static double lowest_step(const tk_run *run, size_t *steps)
+{
+    const tk_step_report *h = tk_run_history(run, steps);
+    double low = INFINITY;
+    for (size_t i = 0; i < *steps; i++)
+        low = fmin(low, h[i].ropelength);
+    return low;
+}
+
 typedef struct watch {
     double tau;
     double tolerance;
@@ -611,10 +633,8 @@ START_TEST(a_fine_tight_polygon_is_restored_in_place)
      * 13% and more, at any damping), the inequality steps crawl, and the
      * start was scaled up by 1 + 9.3e-6; steps measured by their bending
      * as well must restore it in place. */
-    tk_curve *c = NULL;
+    tk_curve *c = test_data("trefoil-2400.vect");
     tk_error err;
-    ck_assert_msg(tk_vect_read_file("tests/data/trefoil-2400.vect", NULL, &c, &err) == TK_OK,
-                  "%s", err.message);
     tk_measure m;
     ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, NULL), TK_OK);
     double before = tk_curve_length(c);
@@ -661,10 +681,8 @@ START_TEST(a_fine_tight_curve_polishes_at_the_rate_of_its_fall)
      * by about 1e-10 a step, far less than the level's bound (1e-4 / 9)
      * over its window of 733 steps, and the level ends after its first
      * 200 steps at that rate instead of waiting for the whole window. */
-    tk_curve *c = NULL;
+    tk_curve *c = test_data("trefoil-600.vect");
     tk_error err;
-    ck_assert_msg(tk_vect_read_file("tests/data/trefoil-600.vect", NULL, &c, &err) == TK_OK,
-                  "%s", err.message);
     tk_options o = TK_OPTIONS_INIT;
     o.coarse_to_fine = false;
     o.escapes = 0;
@@ -713,10 +731,8 @@ START_TEST(a_tight_curve_tightened_again_steps_at_a_bounded_cost)
      * NNLS's fallback: 2,457 pivots and 175 factorisations a warm step
      * (now 144 and 32).  The motion must still balance the gradient (the
      * KKT residual) at a bounded count of pivots, and the run polish. */
-    tk_curve *c = NULL;
+    tk_curve *c = test_data("trefoil-600.vect");
     tk_error err;
-    ck_assert_msg(tk_vect_read_file("tests/data/trefoil-600.vect", NULL, &c, &err) == TK_OK,
-                  "%s", err.message);
     tk_options o = TK_OPTIONS_INIT;
     o.coarse_to_fine = false;
     o.escapes = 0;
@@ -1352,13 +1368,10 @@ START_TEST(escapes_keep_the_best_and_repeat)
     /* the curve returned is the lowest of every step's (the run has one
      * polygon), not only of those where a try was judged */
     size_t nh = 0;
-    const tk_step_report *h = tk_run_history(a, &nh);
-    double lowest = INFINITY;
-    for (size_t i = 0; i < nh; i++)
-        lowest = fmin(lowest, h[i].ropelength);
-    printf("returned %.9f, lowest of %zu steps %.9f\n", end->ropelength, nh, lowest);
-    ck_assert_msg(end->ropelength <= lowest * (1.0 + 1e-12), "%.12f above %.12f",
-                  end->ropelength, lowest);
+    double low = lowest_step(a, &nh);
+    printf("returned %.9f, lowest of %zu steps %.9f\n", end->ropelength, nh, low);
+    ck_assert_msg(end->ropelength <= low * (1.0 + 1e-12), "%.12f above %.12f",
+                  end->ropelength, low);
     /* measured independently: feasible, at the start's vertex count */
     const tk_curve *c = tk_run_curve(a);
     ck_assert_uint_eq(c->nvert, 80);
@@ -1925,19 +1938,16 @@ START_TEST(a_best_put_back_is_polished_not_replayed)
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
     ck_assert_msg(tk_run_until(run, NULL, &err) == TK_OK, "%s", err.message);
     size_t nh = 0, ne = 0;
-    const tk_step_report *h = tk_run_history(run, &nh);
+    double low = lowest_step(run, &nh);
     (void)tk_run_escapes(run, &ne);
     const tk_step_report *end = tk_run_latest(run);
-    double lowest = INFINITY;
-    for (size_t i = 0; i < nh; i++)
-        lowest = fmin(lowest, h[i].ropelength);
     printf("T(2,3), 60 vertices, %ld steps: %zu escape, %d restarts; ends at %.9f, the lowest "
-           "step %.9f\n", end->step, ne, end->restarts, end->ropelength, lowest);
+           "step %.9f\n", end->step, ne, end->restarts, end->ropelength, low);
     ck_assert_uint_eq(ne, 1);
     /* the escape, the best put back, and at most once more at the end */
     ck_assert_int_le(end->restarts, (int)ne + 2);
-    ck_assert_msg(end->ropelength <= lowest * (1.0 + 1e-12), "%.12f above %.12f",
-                  end->ropelength, lowest);
+    ck_assert_msg(end->ropelength <= low * (1.0 + 1e-12), "%.12f above %.12f",
+                  end->ropelength, low);
     /* measured independently: the curve returned is the one reported */
     tk_measure m;
     ck_assert_int_eq(tk_thickness_measure(tk_run_curve(run), NULL, &m, NULL), TK_OK);
