@@ -68,9 +68,23 @@
  * the resolution.  Measured on 3.1 at resolution 33 (1,211 vertices),
  * 150 s with four runs sharing two cores: 32.7531 with 3e-4 throughout;
  * 32.7437, 32.7454, 32.7439, 32.7438, 32.7442 and 32.7525 with factors
- * 0.1, 0.2, 0.3, 0.4, 0.65 and 1.5.  Below about 750 vertices of a tight
+ * 0.1, 0.2, 0.3, 0.4, 0.65 and 1.5.  Below about 520 vertices of a tight
  * trefoil the options' tolerance is the smaller. */
 #define ACTIVE_PER_EDGE2 0.3
+/* Where the active tolerance is reckoned from the edge (above), polishing
+ * takes it down at most POLISH_LEVELS_EDGE levels: to a thirtieth or so of
+ * h^2, below which the pair next to a contact drops out of the active set
+ * and comes back in through the step control.  The test data's tight
+ * trefoil at 2,400 vertices held at a fourth level (1.7e-7 of the
+ * diameter, 0.004 h^2) flipped from one step to the next between 600 and
+ * 6,400 struts, the larger sets found by the step control (1.3 to 1.5 s a
+ * step, the ropelength unmoved over 30 steps), where at the third it held
+ * 2,800 struts at 62 ms a step (bench/steps --curve); loose trefoils
+ * tightened at 2,400 vertices reached the fourth level after about 340 s
+ * and stepped at 5 to 9 s there.  Coarser polygons keep the options'
+ * tolerance (below 0.3 h^2: fewer than about 520 vertices of a tight
+ * trefoil, 960 of 8_19) and all POLISH_LEVELS levels. */
+#define POLISH_LEVELS_EDGE 3
 /* A kink is active when its radius function is within the active
  * tolerance times the function's stiffness, at most KINK_TOLERANCE_MOST
  * of the bound.  Moving a vertex by d normal to its edges (e in
@@ -165,6 +179,15 @@ size_t tk_schedule_window(const tk_run *r, size_t steps)
     if (!(h > 0.0) || h >= WINDOW_EDGE)
         return steps;
     return (size_t)lround((double)steps * WINDOW_EDGE / h);
+}
+
+/* The levels polishing may go down: fewer where the tolerance is reckoned
+ * from the edge (POLISH_LEVELS_EDGE). */
+static int polish_levels(const tk_run *r)
+{
+    double h = mean_edge(r);
+    return h > 0.0 && ACTIVE_PER_EDGE2 * h * h < r->opt.active_tolerance ? POLISH_LEVELS_EDGE
+                                                                          : POLISH_LEVELS;
 }
 
 double tk_tolerance_active(const tk_run *r)
@@ -700,7 +723,7 @@ static bool stalled(const tk_run *r)
  * before its error recovery (which then works to the new tolerances). */
 void tk_schedule_watch(tk_run *r)
 {
-    if (r->schedule.polish_level < POLISH_LEVELS &&
+    if (r->schedule.polish_level < polish_levels(r) &&
         (stalled(r) || critical_since(r, r->schedule.polish_from)) &&
         !tk_schedule_move_on(r)) {
         r->schedule.polish_level++;

@@ -721,6 +721,51 @@ START_TEST(a_fine_tight_curve_polishes_at_the_rate_of_its_fall)
 }
 END_TEST
 
+/* Where the active tolerance is reckoned from the edge (0.3 h^2 under the
+ * options' tolerance: the 600-vertex trefoil's is 2.2e-4 against 3e-4)
+ * polishing stops at the third level; with a smaller options' tolerance,
+ * the same curve and the same rule for a level's end, the fourth comes.
+ * Resumed at the third level, the rate of the fall ends it at step 236
+ * (at 216 with the smaller tolerance) when it may end. */
+START_TEST(polishing_stops_at_the_third_level_where_the_edge_sets_the_tolerance)
+{
+    tk_curve *c = test_data("trefoil-600.vect");
+    tk_error err;
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, &err), TK_OK);
+    const tk_options defaults = TK_OPTIONS_INIT;
+    const double tolerances[] = {defaults.active_tolerance, 1e-4};
+    const int expect[] = {3, 4};
+    for (int k = 0; k < 2; k++) {
+        tk_options o = TK_OPTIONS_INIT;
+        o.coarse_to_fine = false;
+        o.escapes = 0;
+        o.active_tolerance = tolerances[k];
+        tk_resume at;
+        memset(&at, 0, sizeof at);
+        at.start_ropelength = m.ropelength;
+        at.polish_level = 3;
+        tk_run *run = NULL;
+        ck_assert_msg(tk_run_resume(c, &o, &at, NULL, NULL, NULL, &run, &err) == TK_OK, "%s",
+                      err.message);
+        double start = tk_run_latest(run)->ropelength, h = start / (2.0 * 600.0);
+        tk_resume now = at;
+        while (tk_run_latest(run)->step < 300 && now.polish_level == 3) {
+            ck_assert_int_eq(tk_run_step(run, &err), TK_OK);
+            tk_run_resume_point(run, &now);
+        }
+        printf("tight trefoil at 600 vertices, active tolerance %g (0.3 h^2 = %.3g), from "
+               "polishing level 3: level %d at step %ld\n",
+               o.active_tolerance, 0.3 * h * h, now.polish_level, tk_run_latest(run)->step);
+        ck_assert_int_eq(now.polish_level, expect[k]);
+        ck_assert_msg(tk_run_latest(run)->ropelength < start * (1.0 + 1e-6), "%.9f -> %.9f",
+                      start, tk_run_latest(run)->ropelength);
+        tk_run_free(&run);
+    }
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(a_tight_curve_tightened_again_steps_at_a_bounded_cost)
 {
     /* tests/data/trefoil-600.vect: catalogue 3.1 tightened at 600
@@ -1987,6 +2032,7 @@ int main(void)
     tcase_add_test(tc, a_fine_tight_polygon_is_restored_in_place);
     tcase_add_test(tc, a_tight_curve_tightened_again_steps_at_a_bounded_cost);
     tcase_add_test(tc, a_fine_tight_curve_polishes_at_the_rate_of_its_fall);
+    tcase_add_test(tc, polishing_stops_at_the_third_level_where_the_edge_sets_the_tolerance);
     tcase_add_test(tc, a_refined_tight_polygon_is_restored_without_rescaling);
     tcase_add_test(tc, a_loose_curve_is_kept_at_the_tube);
     tcase_add_test(tc, a_loose_start_keeps_its_final_count_through_escapes);
