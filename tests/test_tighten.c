@@ -2003,6 +2003,69 @@ START_TEST(a_best_put_back_is_polished_not_replayed)
 }
 END_TEST
 
+/* Every figure a run reports, in order. */
+typedef struct reports {
+    tk_step_report *items;
+    size_t count, capacity;
+} reports;
+
+static int keep_report(const tk_step_report *s, void *user)
+{
+    reports *all = user;
+    if (all->count == all->capacity) {
+        all->capacity = all->capacity ? 2 * all->capacity : 256;
+        all->items = realloc(all->items, all->capacity * sizeof *all->items);
+        ck_assert_ptr_nonnull(all->items);
+    }
+    all->items[all->count++] = *s;
+    return 0;
+}
+
+/* A run that stops before it has tried an escape returns its best curve
+ * too, not the one its budget ended on: near its critical point the
+ * ropelength goes up and down by about the overstep tolerance.  T(2,3) at
+ * 60 vertices on one polygon stands at 32.98688314 at step 436, above
+ * its 32.98687725 of some steps before (its first escape comes after
+ * step 480). */
+START_TEST(a_run_that_tried_no_escape_returns_its_best)
+{
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 60, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.coarse_to_fine = false;
+    o.max_steps = 436;
+    tk_run *run = NULL;
+    tk_error err;
+    reports all = {0};
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    tk_run_set_progress(run, keep_report, &all);
+    ck_assert_msg(tk_run_until(run, NULL, &err) == TK_OK, "%s", err.message);
+    size_t ne = 0;
+    (void)tk_run_escapes(run, &ne);
+    ck_assert_uint_eq(ne, 0);
+    ck_assert_uint_ge(all.count, 2);
+    /* the step the budget ended on, then the best put back in its place */
+    const tk_step_report *stopped = &all.items[all.count - 2], *end = tk_run_latest(run);
+    double low = INFINITY;
+    for (size_t k = 0; k + 1 < all.count; k++)
+        low = fmin(low, all.items[k].ropelength);
+    printf("T(2,3), 60 vertices, one polygon, %ld steps: stopped at %.9f, the lowest step "
+           "%.9f, returned %.9f\n", stopped->step, stopped->ropelength, low, end->ropelength);
+    ck_assert_int_eq(stopped->step, (long)o.max_steps);
+    ck_assert_msg(stopped->ropelength > low * (1.0 + 1e-8), "%.12f is the lowest", low);
+    ck_assert_int_eq(end->step, stopped->step);
+    ck_assert_msg(end->ropelength == low, "%.12f, not the lowest %.12f", end->ropelength, low);
+    /* measured independently: the curve returned is the one reported */
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(tk_run_curve(run), NULL, &m, NULL), TK_OK);
+    ck_assert(fabs(m.ropelength - low) <= 1e-9 * low);
+    free(all.items);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("tighten");
@@ -2020,6 +2083,7 @@ int main(void)
     tcase_add_test(tc, a_crawling_run_escapes_after_a_fifth_of_its_budget);
     tcase_add_test(tc, the_last_fifth_of_the_budget_polishes_the_best);
     tcase_add_test(tc, a_best_put_back_is_polished_not_replayed);
+    tcase_add_test(tc, a_run_that_tried_no_escape_returns_its_best);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
     tcase_add_test(tc, vertices_option_ends_at_exactly_that_count);
