@@ -9,12 +9,14 @@
  *
  *   bench/steps [CATALOGUE_DIR] [--warm S] [--settle N] [--steps N]
  *               [--budget S] [VERTICES ...]
+ *   bench/steps --curve FILE [--level L] [--steps N]
  */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "tk/curve.h"
+#include "tk/thickness.h"
 #include "tk/tighten.h"
 #include "tk/vect.h"
 
@@ -23,13 +25,16 @@ static void usage(void)
     fprintf(stderr,
             "usage: bench/steps [CATALOGUE_DIR] [--warm S] [--settle N] [--steps N]\n"
             "                   [--budget S] [VERTICES ...]\n"
+            "       bench/steps --curve FILE [--level L] [--steps N]\n"
             "Tightens catalogue 3.1 at resolution 10 for S seconds (--warm, default 60),\n"
             "then for each vertex count (default 600 1200 2400 4800): resamples it,\n"
             "settles it for N steps (--settle, default 40), scales it into contact and\n"
             "prints milliseconds per step over N steps (--steps, default 5, or as many\n"
             "as --budget seconds allow, default 300) with where the time went.\n"
             "With --curve FILE: tightens FILE's curve again (no autoscale, no escapes)\n"
-            "and prints each of its first N steps (--steps), the first one cold.\n");
+            "and prints each of its first N steps (--steps), the first one cold; with\n"
+            "--level L it goes on at polishing level L (as a run that polished that\n"
+            "far: the tolerances a tight curve ends a run with) instead of level 0.\n");
 }
 
 static tk_run *start(const tk_curve *c, const tk_options *o)
@@ -89,19 +94,39 @@ static tk_curve *read_curve(const char *path, const char *hint)
     return c;
 }
 
-/* --curve: FILE's curve tightened again, a row per step. */
-static int again(const char *path, long steps)
+/* --curve: FILE's curve tightened again, a row per step; from polishing
+ * level `level` when it is not negative (resumed there). */
+static int again(const char *path, int level, long steps)
 {
     tk_curve *c = read_curve(path, "");
     if (!c)
         return 1;
     tk_options o = TK_OPTIONS_INIT;
     o.escapes = 0;
-    tk_run *run = start(c, &o);
-    printf("%s tightened again: %zu vertices, ropelength %.7f; each step's row:\n", path,
-           c->nvert, tk_run_latest(run)->ropelength);
-    header();
     tk_error err;
+    tk_run *run = NULL;
+    if (level < 0)
+        run = start(c, &o);
+    else {
+        tk_resume at;
+        memset(&at, 0, sizeof at);
+        at.polish_level = level;
+        at.start_ropelength = 0.0;
+        tk_measure m;
+        if (tk_thickness_measure(c, NULL, &m, &err) == TK_OK)
+            at.start_ropelength = m.ropelength;
+        if (tk_run_resume(c, &o, &at, NULL, NULL, NULL, &run, &err) != TK_OK) {
+            fprintf(stderr, "bench/steps: %s\n", err.message);
+            tk_curve_free(&c);
+            return 1;
+        }
+    }
+    char from[48] = "";
+    if (level >= 0)
+        snprintf(from, sizeof from, " from polishing level %d", level);
+    printf("%s tightened again%s: %zu vertices, ropelength %.7f; each step's row:\n", path,
+           from, c->nvert, tk_run_latest(run)->ropelength);
+    header();
     for (long k = 0; k < steps; k++) {
         tk_run_timing a, b;
         tk_run_timing_get(run, &a);
@@ -130,6 +155,7 @@ static void run_to_stop(tk_run *run)
 int main(int argc, char **argv)
 {
     const char *dir = "../shared/catalogue", *curve = NULL;
+    int level = -1;
     double warm = 60.0, budget = 300.0;
     long settle = 40, steps = 5;
     size_t counts[16], ncounts = 0;
@@ -141,6 +167,8 @@ int main(int argc, char **argv)
             warm = strtod(argv[++i], NULL);
         } else if (strcmp(argv[i], "--curve") == 0 && i + 1 < argc) {
             curve = argv[++i];
+        } else if (strcmp(argv[i], "--level") == 0 && i + 1 < argc) {
+            level = atoi(argv[++i]);
         } else if (strcmp(argv[i], "--settle") == 0 && i + 1 < argc) {
             settle = strtol(argv[++i], NULL, 10);
         } else if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
@@ -158,7 +186,7 @@ int main(int argc, char **argv)
         }
     }
     if (curve)
-        return again(curve, steps);
+        return again(curve, level, steps);
     if (ncounts == 0) {
         size_t defaults[] = {600, 1200, 2400, 4800};
         memcpy(counts, defaults, sizeof defaults);

@@ -327,9 +327,9 @@ typedef struct tk_resume {
 /* The run's place, for tk_run_resume. */
 void tk_run_resume_point(const tk_run *r, tk_resume *out);
 
-/* The best curve on the final polygon so far (kept by the escapes) and
- * its figures into *report; NULL when there is none (no escape has
- * started: the run's curve is its best). */
+/* The best curve on the final polygon so far (kept by the escapes at
+ * every step) and its figures into *report; NULL when there is none
+ * (escapes off, or no step on the final polygon yet). */
 const tk_curve *tk_run_best(const tk_run *r, tk_step_report *report);
 
 /* A run that goes on from `curve` (the run's curve when `at` was taken),
