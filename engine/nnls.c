@@ -772,10 +772,23 @@ static int work_alloc(nnls_work *w, tk_error *err)
  * least NNLS_PRIMAL_LEAST only; the flow's rounds (engine/motion.c) go
  * from 1e-2 down to 1e-12 and seldom need the last ones. */
 #define NNLS_PRIMAL_LEAST 1e-8
+/* The crossover is not a fixed share of the coordinates either: the n_F x n_F
+ * factor fills faster than the m x m one as both grow.  On a
+ * 4,800-vertex trefoil near tight (14,400 coordinates; bench/steps
+ * --curve FILE --level 3, 30 steps) 6,300 passive columns, under half
+ * the coordinates, gave an L of 885 thousand entries and 2.45e8 flops a
+ * factorisation, and steps of 1.7 s (mean; median 1.4 s, 13
+ * factorisations a step); in the coordinate form from 2,000 passive
+ * columns on, 0.21 s (median 0.12 s, 5 factorisations), the ropelengths
+ * the same to the printed digits.  So the coordinate form also serves
+ * any passive set of more than NNLS_PRIMAL_COLUMNS columns, the count at
+ * which the two cost the same at 1,200 vertices.  Below 4,000
+ * coordinates (1,333 vertices) that changes nothing. */
+#define NNLS_PRIMAL_COLUMNS 2000
 
 static bool primal_pays(const nnls_work *w, size_t nf)
 {
-    return w->mu >= NNLS_PRIMAL_LEAST && 2 * nf > w->m;
+    return w->mu >= NNLS_PRIMAL_LEAST && (2 * nf > w->m || nf > NNLS_PRIMAL_COLUMNS);
 }
 
 static int primal_alloc(nnls_work *w, tk_error *err)

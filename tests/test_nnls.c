@@ -1322,6 +1322,57 @@ START_TEST(proximal_rounds_on_wide_problems)
 END_TEST
 
 
+/* The coordinate form (m x m) serves a passive set of more than 2,000
+ * columns even when they are fewer than half the coordinates: there the
+ * n_F x n_F factor fills far more (tk/nnls.h).  A flow problem on 1,600
+ * vertices (4,800 coordinates) whose proximal answer is a chosen x0 > 0
+ * on 2,200 of its 2,600 columns (b = A x0, centred at x0): the answer
+ * comes back, its KKT conditions hold, and the coordinate form's factor
+ * is kept; on 1,500 columns the other form serves (no factor kept). */
+START_TEST(many_passive_columns_use_the_coordinate_form)
+{
+    tk_nnls *s = new_solver();
+    cholmod_common *cc = tk_nnls_common(s);
+    tkt_rng r = {2026};
+    const size_t V = 1600, n = 2600, supports[] = {2200, 1500};
+    cholmod_sparse *A = flow_matrix(cc, &r, V, n);
+    size_t m = A->nrow;
+    for (int k = 0; k < 2; k++) {
+        double *x0 = calloc(n, sizeof *x0), *x = calloc(n, sizeof *x), *b = calloc(m, sizeof *b);
+        ck_assert(x0 && x && b);
+        for (size_t j = 0; j < supports[k]; j++)
+            x0[j] = tkt_rng_range(&r, 0.5, 1.5) / column_norm(A, j);
+        const int *Ap = A->p, *Ai = A->i;
+        const double *Ax = A->x;
+        for (size_t j = 0; j < n; j++)
+            for (int e = Ap[j]; e < Ap[j + 1]; e++)
+                b[Ai[e]] += Ax[e] * x0[j];
+        tk_nnls_options o = tight;
+        o.warm_start = true;
+        o.proximal = 1e-2;
+        memcpy(x, x0, n * sizeof *x);
+        char what[80];
+        snprintf(what, sizeof what, "%zu of %zu columns on %zu coordinates", supports[k], n, m);
+        tk_nnls_report rep;
+        ck_assert_msg(solve(s, A, b, x, &o, &rep) == TK_OK, "%s: not converged", what);
+        assert_proximal_kkt(A, b, x0, o.proximal, x, 1e-9, what);
+        ck_assert_uint_eq(rep.passive, supports[k]);
+        ck_assert_msg(2 * rep.passive < m, "%s: more than half the coordinates", what);
+        double gap = 0.0;
+        for (size_t j = 0; j < n; j++)
+            gap = fmax(gap, column_norm(A, j) * fabs(x[j] - x0[j]));
+        ck_assert_msg(gap <= 1e-9, "%s: %g from the chosen answer", what, gap);
+        printf("%s: %s form\n", what, rep.kept ? "coordinate" : "normal");
+        ck_assert_int_eq(rep.kept, supports[k] > 2000);
+        free(x0);
+        free(x);
+        free(b);
+    }
+    cholmod_free_sparse(&A, cc);
+    tk_nnls_free(&s);
+}
+END_TEST
+
 /* The scaled largest difference of two answers, against the first's size. */
 static double answer_gap(const cholmod_sparse *A, const double *x, const double *y)
 {
@@ -1445,6 +1496,7 @@ int main(void)
     tcase_add_test(tc, two_threads_match_series);
     tcase_add_test(tc, proximal_problems);
     tcase_add_test(tc, proximal_rounds_on_wide_problems);
+    tcase_add_test(tc, many_passive_columns_use_the_coordinate_form);
     tcase_add_test(tc, kept_factor_serves_the_same_matrix_only);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);

@@ -25,8 +25,9 @@
  * the symbolic analysis between calls and reuses it when the passive set's
  * pattern repeats.
  *
- * Where the passive columns are more than half as many as the rows (many
- * contacts) and the problem is the proximal one below with mu >= 1e-8,
+ * Where the passive columns are more than half as many as the rows, or
+ * more than 2,000 (many contacts), and the problem is the proximal one
+ * below with mu >= 1e-8,
  * the solver works with the m x m matrix A_F D^-2 A_F^T + mu I instead of
  * the n_F x n_F normal matrix (the coordinate form: far sparser there),
  * and block pivoting and Lawson and Hanson modify its factor with rank-one
