@@ -51,6 +51,23 @@ static double lowest_step(const tk_run *run, size_t *steps)
     return low;
 }
 
+/* A run resumed on c at polishing level `level` (the test fails when it
+ * cannot be). */
+static tk_run *resumed_at_level(const tk_curve *c, const tk_options *o, int level)
+{
+    tk_error err;
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, &err), TK_OK);
+    tk_resume at;
+    memset(&at, 0, sizeof at);
+    at.start_ropelength = m.ropelength;
+    at.polish_level = level;
+    tk_run *run = NULL;
+    ck_assert_msg(tk_run_resume(c, o, &at, NULL, NULL, NULL, &run, &err) == TK_OK, "%s",
+                  err.message);
+    return run;
+}
+
 typedef struct watch {
     double tau;
     double tolerance;
@@ -686,19 +703,12 @@ START_TEST(a_fine_tight_curve_polishes_at_the_rate_of_its_fall)
     tk_options o = TK_OPTIONS_INIT;
     o.coarse_to_fine = false;
     o.escapes = 0;
-    tk_measure m;
-    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, &err), TK_OK);
-    tk_resume at;
-    memset(&at, 0, sizeof at);
-    at.start_ropelength = m.ropelength;
-    at.polish_level = 2;
-    tk_run *run = NULL;
-    ck_assert_msg(tk_run_resume(c, &o, &at, NULL, NULL, NULL, &run, &err) == TK_OK, "%s",
-                  err.message);
+    tk_run *run = resumed_at_level(c, &o, 2);
     double start = tk_run_latest(run)->ropelength;
     const long steps = 215;
     long above = -1; /* the last step with a residual of 1e-3 or more */
-    tk_resume now = at;
+    tk_resume now;
+    tk_run_resume_point(run, &now);
     while (tk_run_latest(run)->step < steps && now.polish_level == 2) {
         ck_assert_int_eq(tk_run_step(run, &err), TK_OK);
         const tk_step_report *s = tk_run_latest(run);
@@ -731,8 +741,6 @@ START_TEST(polishing_stops_at_the_third_level_where_the_edge_sets_the_tolerance)
 {
     tk_curve *c = test_data("trefoil-600.vect");
     tk_error err;
-    tk_measure m;
-    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, &err), TK_OK);
     const tk_options defaults = TK_OPTIONS_INIT;
     const double tolerances[] = {defaults.active_tolerance, 1e-4};
     const int expect[] = {3, 4};
@@ -741,15 +749,10 @@ START_TEST(polishing_stops_at_the_third_level_where_the_edge_sets_the_tolerance)
         o.coarse_to_fine = false;
         o.escapes = 0;
         o.active_tolerance = tolerances[k];
-        tk_resume at;
-        memset(&at, 0, sizeof at);
-        at.start_ropelength = m.ropelength;
-        at.polish_level = 3;
-        tk_run *run = NULL;
-        ck_assert_msg(tk_run_resume(c, &o, &at, NULL, NULL, NULL, &run, &err) == TK_OK, "%s",
-                      err.message);
+        tk_run *run = resumed_at_level(c, &o, 3);
         double start = tk_run_latest(run)->ropelength, h = start / (2.0 * 600.0);
-        tk_resume now = at;
+        tk_resume now;
+        tk_run_resume_point(run, &now);
         while (tk_run_latest(run)->step < 300 && now.polish_level == 3) {
             ck_assert_int_eq(tk_run_step(run, &err), TK_OK);
             tk_run_resume_point(run, &now);
