@@ -111,7 +111,6 @@ static int again(const char *path, int level, long steps)
         tk_resume at;
         memset(&at, 0, sizeof at);
         at.polish_level = level;
-        at.start_ropelength = 0.0;
         tk_measure m;
         if (tk_thickness_measure(c, NULL, &m, &err) == TK_OK)
             at.start_ropelength = m.ropelength;

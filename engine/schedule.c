@@ -72,8 +72,8 @@
  * trefoil the options' tolerance is the smaller. */
 #define ACTIVE_PER_EDGE2 0.3
 /* Where the active tolerance is reckoned from the edge (above), polishing
- * takes it down at most POLISH_LEVELS_EDGE levels: to a thirtieth or so of
- * h^2, below which the pair next to a contact drops out of the active set
+ * takes it down at most POLISH_LEVELS_EDGE levels: to 0.3 h^2 / 27, about
+ * 0.01 h^2, below which the pair next to a contact drops out of the active set
  * and comes back in through the step control.  The test data's tight
  * trefoil at 2,400 vertices held at a fourth level (1.7e-7 of the
  * diameter, 0.004 h^2) flipped from one step to the next between 600 and
