@@ -157,6 +157,12 @@ struct tk_run {
         bool due;            /* deform before the next step */
         bool reserved;       /* the budget's reserve for the best has begun */
         bool polishing;      /* the curve is the best put back, not a try */
+        double coarse;       /* where the curve under way (the first
+                                tightening or a try) left its coarsest
+                                polygon, NAN before that */
+        size_t coarse_vertices; /* that polygon's vertices */
+        double best_coarse;  /* the same for the best's tightening */
+        size_t best_coarse_vertices;
         tk_escape *log;      /* one per try */
         size_t nlog, log_capacity;
         int improved;

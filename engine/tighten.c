@@ -167,6 +167,7 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
     r->life.started = tk_clock() - (at ? at->seconds : 0.0);
     r->type.checked_step = -1;
     r->escape.rng = opts->seed;
+    r->escape.coarse = r->escape.best_coarse = NAN;
     rc = tk_nnls_new(&r->shared.nnls, err);
     if (!rc)
         rc = at ? tk_schedule_resume(r, start, at, err) : tk_schedule_start(r, start, err);

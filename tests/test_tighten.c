@@ -2069,6 +2069,88 @@ START_TEST(a_run_that_tried_no_escape_returns_its_best)
 }
 END_TEST
 
+/* A try is judged where it leaves its coarsest polygon, against where the
+ * best's own tightening left it (escape.c, judge_coarse): behind, it is
+ * given up there, takes no step on the final polygon, and the next try
+ * starts at once; not behind, it goes on to the final polygon.  T(2,3)
+ * from the round torus at 200 vertices: every tightening's coarsest
+ * polygon has 100.  The lineage is rebuilt from the history and the
+ * escapes' log alone: the first tightening's last step before its first
+ * refinement, then the coarse figure of each try that improved.  (A run
+ * whose first tightening starts on the final polygon, as at 170 vertices,
+ * where the torus is too long for a coarse level, has no lineage until a
+ * try improves, and refines every try until then.) */
+START_TEST(a_try_behind_on_its_coarsest_polygon_is_given_up_there)
+{
+    if (quick() && tkt_skip("a_try_behind_on_its_coarsest_polygon_is_given_up_there", LONG_RUN))
+        return;
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 120, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.vertices = 200;
+    o.escapes = 8;
+    o.max_steps = 20000; /* the fourth try, at step 11,098, is refined */
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_msg(tk_run_until(run, NULL, &err) == TK_OK, "%s", err.message);
+    size_t nh = 0, ne = 0;
+    const tk_step_report *h = tk_run_history(run, &nh);
+    const tk_escape *e = tk_run_escapes(run, &ne);
+    ck_assert_uint_eq(h[0].vertices, 100); /* the first tightening starts coarse */
+    double lineage = NAN;
+    for (size_t i = 1; i < nh && isnan(lineage); i++)
+        if (h[i].vertices > h[i - 1].vertices) {
+            ck_assert_uint_eq(h[i - 1].vertices, 100);
+            lineage = h[i - 1].ropelength;
+        }
+    ck_assert(!isnan(lineage));
+    size_t given_up = 0, refined = 0;
+    for (size_t k = 0; k < ne; k++) {
+        /* the try's steps: escapes counts the tries begun */
+        size_t first = nh, last = 0, on_final = 0;
+        for (size_t i = 0; i < nh; i++)
+            if (h[i].escapes == (int)k + 1 && h[i].restarts == h[0].restarts + (int)k + 1) {
+                first = i < first ? i : first;
+                last = i;
+                on_final += h[i].vertices == o.vertices;
+            }
+        ck_assert_uint_lt(first, nh);
+        bool ended = k + 1 < ne; /* the last can be cut short by the budget or the reserve */
+        printf("try %zu: steps %ld-%ld, from %.6f, coarse %.6f against %.6f, %zu steps on the "
+               "final polygon, reached %.6f\n", k + 1, h[first].step, h[last].step, e[k].from,
+               e[k].coarse, lineage, on_final, e[k].reached);
+        if (isnan(e[k].coarse)) {
+            ck_assert(!ended);
+            continue;
+        }
+        ck_assert_uint_eq(h[first].vertices, 100);
+        if (e[k].coarse > lineage) {
+            /* given up on its coarse polygon, at its last step there */
+            ck_assert_uint_eq(on_final, 0);
+            ck_assert(isnan(e[k].reached));
+            if (ended) {
+                ck_assert(e[k].coarse == h[last].ropelength);
+                given_up++;
+            }
+        } else if (ended) {
+            ck_assert_uint_gt(on_final, 0);
+            ck_assert(!isnan(e[k].reached));
+            refined++;
+        }
+        if (e[k].improved)
+            lineage = e[k].coarse;
+    }
+    printf("T(2,3) at 200 vertices, %zu tries: %zu given up on the coarse polygon, %zu refined; "
+           "ends at %.6f\n", ne, given_up, refined, tk_run_latest(run)->ropelength);
+    ck_assert_uint_gt(given_up, 0);
+    ck_assert_uint_gt(refined, 0);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("tighten");
@@ -2087,6 +2169,7 @@ int main(void)
     tcase_add_test(tc, the_last_fifth_of_the_budget_polishes_the_best);
     tcase_add_test(tc, a_best_put_back_is_polished_not_replayed);
     tcase_add_test(tc, a_run_that_tried_no_escape_returns_its_best);
+    tcase_add_test(tc, a_try_behind_on_its_coarsest_polygon_is_given_up_there);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
     tcase_add_test(tc, vertices_option_ends_at_exactly_that_count);

@@ -226,14 +226,18 @@ const tk_strut *tk_run_struts(const tk_run *r, size_t *count);
 const tk_kink *tk_run_kinks(const tk_run *r, size_t *count);
 tk_stop_reason tk_run_stop_reason(const tk_run *r);
 
-/* One escape: where it started, the best ropelength then, and what its
- * tightening reached on the final polygon (NAN while under way, or when
- * the run stopped or gave it up first: the last fifth of the budget
- * polishes the best curve, and what that reaches is no try's). */
+/* One escape: where it started, the best ropelength then, where its
+ * coarsest polygon ended, and what its tightening reached on the final
+ * polygon (NAN while under way, or when the run stopped or gave it up
+ * first: a try whose coarsest polygon ended above the best's is given up
+ * there, and the last fifth of the budget polishes the best curve, and
+ * what that reaches is no try's). */
 typedef struct tk_escape {
     long step;          /* the step after which the deformation was made */
     double from;        /* the best ropelength when it started */
     double amplitude;   /* of the deformation, in tube diameters */
+    double coarse;      /* its coarsest polygon's last ropelength (NAN:
+                           none, or not left yet) */
     double reached;
     bool improved;      /* reached < from */
 } tk_escape;
