@@ -215,7 +215,7 @@ describe('one client cannot take the service', () => {
             // and the memory with it (not under the sanitizers: the address
             // sanitizer's allocator keeps freed memory in quarantine, and
             // the thread sanitizer's shadow grows with all memory touched,
-            // 45 MiB here once): 8 MiB of bodies and slack, where without
+            // 45,300 KiB here once): 8 MiB of bodies and slack, where without
             // the budget it would be 160 MiB
             if (!/lib[at]san/.test(readFileSync(`/proc/${d.proc.pid}/maps`, 'utf8')))
                 assert.ok(grown < 40 * 1024, `grew by ${grown} KiB`);
