@@ -263,7 +263,7 @@ static int deformed_best(tk_run *r, tk_curve **out, double *amplitude, tk_error 
  * final polygon does.  At 489 vertices (600 s, seed 1; each try's
  * coarsest polygon has 245), catalogue 8.19's and T(3,4)'s tries ranked
  * the same on both polygons in all 16 comparisons with the best, and the
- * tries that failed had spent 143 s and 45 s on their final polygons.
+ * tries that failed had spent 184 s and 45 s on their final polygons.
  * Given up at once, they leave that time to polish the best: 8.19 ended
  * at 60.99446 (60.99462 and 60.99555 before), T(3,4) at 61.0145
  * (61.01725 and 61.01793).  A best with no such figure (a run whose
