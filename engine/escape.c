@@ -76,6 +76,7 @@
 void tk_escape_free(tk_run *r)
 {
     tk_curve_free(&r->escape.best);
+    tk_curve_free(&r->escape.explored);
     tk_constraints_free(&r->escape.best_set);
     free(r->escape.log);
 }
@@ -95,6 +96,19 @@ bool tk_escape_converged(const tk_run *r)
                ESCAPE_CRAWL;
 }
 
+/* *kept becomes a copy of c, in place when it has c's shape; NULL when
+ * that fails. */
+static int keep(tk_curve **kept, const tk_curve *c, tk_error *err)
+{
+    if (*kept && (*kept)->nvert == c->nvert && (*kept)->ncomp == c->ncomp &&
+        !memcmp((*kept)->offset, c->offset, c->ncomp * sizeof *c->offset)) {
+        memcpy((*kept)->xyz, c->xyz, 3 * c->nvert * sizeof *c->xyz);
+        return TK_OK;
+    }
+    tk_curve_free(kept);
+    return tk_curve_copy(c, kept, err);
+}
+
 /* The run's curve, on the final polygon, as the result of the try under
  * way (or of the first tightening): logged, and kept if the best. */
 static int note(tk_run *r, tk_error *err)
@@ -102,8 +116,8 @@ static int note(tk_run *r, tk_error *err)
     if (!tk_schedule_final(r))
         return TK_OK;
     const tk_step_report *s = &r->life.latest;
-    if (r->escape.nlog > 0 && !r->escape.polishing) {
-        tk_escape *e = &r->escape.log[r->escape.nlog - 1];
+    tk_escape *e = r->escape.nlog > 0 ? &r->escape.log[r->escape.nlog - 1] : NULL;
+    if (e && !e->explored && !r->escape.polishing) {
         if (isnan(e->reached) || s->ropelength < e->reached) {
             bool was = e->improved;
             e->reached = s->ropelength;
@@ -113,16 +127,7 @@ static int note(tk_run *r, tk_error *err)
     }
     if (r->escape.best && !(s->ropelength < r->escape.best_report.ropelength))
         return TK_OK;
-    const tk_curve *c = r->shared.curve;
-    int rc = TK_OK;
-    if (r->escape.best && r->escape.best->nvert == c->nvert &&
-        r->escape.best->ncomp == c->ncomp &&
-        !memcmp(r->escape.best->offset, c->offset, c->ncomp * sizeof *c->offset))
-        memcpy(r->escape.best->xyz, c->xyz, 3 * c->nvert * sizeof *c->xyz);
-    else {
-        tk_curve_free(&r->escape.best);
-        rc = tk_curve_copy(c, &r->escape.best, err);
-    }
+    int rc = keep(&r->escape.best, r->shared.curve, err);
     if (!rc)
         rc = tk_constraints_copy(&r->escape.best_set, &r->active.set, err);
     if (rc) {
@@ -157,7 +162,7 @@ int tk_escape_tries(const tk_run *r)
 
 static bool tries_left(const tk_run *r)
 {
-    return tk_escape_tries(r) < r->opt.escapes &&
+    return tk_escape_tries(r) - r->escape.explore_tries < r->opt.escapes &&
            tk_schedule_spent(r) < 1.0 - ESCAPE_RESERVE;
 }
 
@@ -214,12 +219,12 @@ static void deform(tk_curve *c, const tk_curve *from, const double *coef, double
     }
 }
 
-/* The largest deformation of the best curve that keeps its type and
- * ESCAPE_THICKNESS of its thickness (ESCAPE_FAR_THICKNESS at odd tries),
- * into *out. */
-static int deformed_best(tk_run *r, tk_curve **out, double *amplitude, tk_error *err)
+/* The largest deformation of `best` (of the given thickness) that keeps
+ * its type and ESCAPE_THICKNESS of its thickness (ESCAPE_FAR_THICKNESS
+ * when far), into *out. */
+static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far, tk_curve **out,
+                    double *amplitude, tk_error *err)
 {
-    const tk_curve *best = r->escape.best;
     size_t ncoef = best->ncomp * ESCAPE_MODES * 6;
     double *coef = malloc(ncoef * sizeof *coef);
     tk_invariants type = TK_INVARIANTS_INIT;
@@ -228,14 +233,14 @@ static int deformed_best(tk_run *r, tk_curve **out, double *amplitude, tk_error 
     for (size_t i = 0; !rc && i < ncoef; i++)
         coef[i] = tk_rng_normal(&r->escape.rng);
     double a = ESCAPE_AMPLITUDE * r->tau;
-    double keep = tk_escape_tries(r) % 2 ? ESCAPE_FAR_THICKNESS : ESCAPE_THICKNESS;
+    double keep = far ? ESCAPE_FAR_THICKNESS : ESCAPE_THICKNESS;
     bool found = false;
     for (int size = 0; !rc && !found && size < ESCAPE_SIZES; size++, a *= ESCAPE_SHRINK) {
         deform(*out, best, coef, a);
         tk_measure m;
         tk_error why;
         if (tk_thickness_measure(*out, NULL, &m, &why) != TK_OK ||
-            !(m.thickness >= keep * r->escape.best_report.thickness))
+            !(m.thickness >= keep * thickness))
             continue;
         double t0 = tk_clock();
         int type_rc = tk_invariants_compute(*out, &type, &why);
@@ -255,6 +260,127 @@ static int deformed_best(tk_run *r, tk_curve **out, double *amplitude, tk_error 
     if (rc)
         tk_curve_free(out);
     return rc;
+}
+
+/* Exploration: before the run first refines its coarsest polygon, tries
+ * start from the lowest curve found there and are judged there alone,
+ * where a step costs a fraction of the final polygon's and kinks are
+ * least stiff.  A plateau of the coarse polygon that is not the tight
+ * knot's is otherwise refined, and the final polygon can take a long
+ * time to leave it, too steadily for a crawl: the figure-eight disguised
+ * by bench/starts (resolution 5) stopped at 55.30 on 142 vertices with
+ * kinks at the curvature bound (residual 0.02); on the final 277 it fell
+ * about 0.05 every 300 steps and was at 44.95 after 120 s, with no
+ * escape.  Its first explored try left that plateau at 42.18 on the
+ * coarse polygon, and the run ended at 42.1238 (+0.063% over the atlas's
+ * 4_1); with a budget of 16,000 steps, 42.1243 against 44.597.
+ * Exploring ends after EXPLORE_FAILS tries in a row that gain less than
+ * EXPLORE_GAIN (a plateau's own spread: tries that end in the same basin
+ * differ by about 2e-5), after EXPLORE_SHARE of the budget, or after as
+ * many tries as the escapes option allows (they are not counted against
+ * it); the lowest curve is then put back on its own ropelength's coarse
+ * polygon, which the later tries will use too.  A try under way when the
+ * share ends goes on instead if it is lower already.  A coarse level can
+ * end while the ropelength still rises (catalogue 3.1 unscaled at step
+ * 201, residual 0.69): exploring starts only from a first plateau whose
+ * residual is below EXPLORE_CRITICAL. */
+#define EXPLORE_SHARE 0.25
+#define EXPLORE_FAILS 3
+#define EXPLORE_GAIN 1e-4
+#define EXPLORE_CRITICAL 0.1
+
+static bool explore_more(const tk_run *r)
+{
+    return r->escape.explore_tries < r->opt.escapes && r->escape.explore_fails < EXPLORE_FAILS &&
+           tk_schedule_spent(r) < EXPLORE_SHARE;
+}
+
+/* The curve under way has left its coarsest polygon while the run
+ * explores: kept if the lowest there, then the next explored try is
+ * asked for or, exploring over, the lowest is put back to go on from
+ * there.  False when the run goes on with this curve (it is the lowest
+ * and exploring is over), as it would without exploring. */
+static bool explore(tk_run *r)
+{
+    const tk_step_report *s = &r->life.latest;
+    tk_escape *e = r->escape.nlog > 0 ? &r->escape.log[r->escape.nlog - 1] : NULL;
+    if (!e && !(s->residual < EXPLORE_CRITICAL)) {
+        r->escape.explore_over = true; /* no plateau: the run goes on as without exploring */
+        return false;
+    }
+    if (e && e->explored) {
+        e->coarse = s->ropelength;
+        e->improved = s->ropelength < e->from;
+        r->escape.improved += e->improved;
+    }
+    /* a gain within a plateau's own spread is no other basin */
+    bool lower = !r->escape.explored || s->ropelength < r->escape.explored_rope;
+    bool gain = !r->escape.explored ||
+                s->ropelength < r->escape.explored_rope * (1.0 - EXPLORE_GAIN);
+    r->escape.explore_fails = gain ? 0 : r->escape.explore_fails + 1;
+    if (lower) {
+        if (keep(&r->escape.explored, r->shared.curve, NULL) != TK_OK) {
+            r->escape.explore_over = true; /* out of memory for the copy: this curve goes on */
+            return false;
+        }
+        r->escape.explored_rope = s->ropelength;
+        r->escape.explored_thickness = s->thickness;
+    }
+    if (!explore_more(r)) {
+        r->escape.explore_over = true;
+        if (!(s->ropelength > r->escape.explored_rope))
+            return false;
+    }
+    r->escape.explore_due = true;
+    return true;
+}
+
+/* A new entry at the end of the escapes' log, or NULL (*err set). */
+static tk_escape *log_entry(tk_run *r, tk_error *err)
+{
+    if (r->escape.nlog == r->escape.log_capacity) {
+        size_t cap = r->escape.log_capacity ? 2 * r->escape.log_capacity : 8;
+        tk_escape *grown = realloc(r->escape.log, cap * sizeof *grown);
+        if (!grown) {
+            tk_error_set(err, TK_ENOMEM, "out of memory for the escapes");
+            return NULL;
+        }
+        r->escape.log = grown;
+        r->escape.log_capacity = cap;
+    }
+    return &r->escape.log[r->escape.nlog++];
+}
+
+/* Before a step asked for by explore(): the next explored try, or the
+ * lowest curve back. */
+static int explore_next(tk_run *r, tk_error *err)
+{
+    tk_curve *curve = NULL;
+    int rc;
+    if (r->escape.explore_over) {
+        rc = tk_curve_copy(r->escape.explored, &curve, err);
+        tk_curve_free(&r->escape.explored);
+        return rc ? rc : tk_schedule_explore(r, curve, r->escape.explored_rope, err);
+    }
+    double amplitude = 0.0;
+    rc = deformed(r, r->escape.explored, r->escape.explored_thickness,
+                  r->escape.explore_tries % 2, &curve, &amplitude, err);
+    tk_escape *e = rc ? NULL : log_entry(r, err);
+    if (!e) {
+        tk_curve_free(&curve);
+        return rc ? rc : TK_ENOMEM;
+    }
+    *e = (tk_escape){
+        .step = r->life.latest.step,
+        .from = r->escape.explored_rope,
+        .amplitude = amplitude,
+        .coarse = NAN,
+        .reached = NAN,
+        .improved = false,
+        .explored = true,
+    };
+    r->escape.explore_tries++;
+    return tk_schedule_explore(r, curve, 0.0, err);
 }
 
 /* A try is judged where it leaves its coarsest polygon, against where the
@@ -277,9 +403,19 @@ static void judge_coarse(tk_run *r)
     const tk_step_report *s = &r->life.latest;
     r->escape.coarse = s->ropelength;
     r->escape.coarse_vertices = s->vertices;
-    if (r->escape.nlog == 0)
-        return; /* the first tightening, or a resumed run's curve */
-    tk_escape *e = &r->escape.log[r->escape.nlog - 1];
+    if (!r->escape.explore_over && explore(r)) {
+        r->escape.coarse = NAN; /* this curve is replaced before it is refined */
+        return;
+    }
+    tk_escape *e = r->escape.nlog > 0 ? &r->escape.log[r->escape.nlog - 1] : NULL;
+    if (e && r->escape.explore_goes_on) {
+        r->escape.explore_goes_on = false;
+        e->coarse = s->ropelength;
+        e->improved = s->ropelength < e->from;
+        r->escape.improved += e->improved;
+    }
+    if (!e || e->explored)
+        return; /* the first tightening (explored or not), or a resumed run's curve */
     e->coarse = s->ropelength;
     if (r->escape.best_coarse_vertices == s->vertices &&
         !(s->ropelength <= r->escape.best_coarse))
@@ -290,6 +426,19 @@ int tk_escape_before_step(tk_run *r, tk_error *err)
 {
     if (r->opt.escapes > 0)
         judge_coarse(r);
+    if (!r->escape.explore_over && r->escape.explore_tries > 0 && !r->escape.explore_due &&
+        !(tk_schedule_spent(r) < EXPLORE_SHARE)) {
+        /* the exploring share spent with a try under way: the lowest goes
+         * on, or the try if it is lower already (and judged where it
+         * leaves its coarsest polygon, as the lowest) */
+        r->escape.explore_over = true;
+        r->escape.explore_goes_on = r->life.latest.ropelength < r->escape.explored_rope;
+        r->escape.explore_due = !r->escape.explore_goes_on;
+    }
+    if (r->escape.explore_due) {
+        r->escape.explore_due = false;
+        return explore_next(r, err);
+    }
     if (!r->escape.due)
         return TK_OK;
     r->escape.due = false;
@@ -303,21 +452,18 @@ int tk_escape_before_step(tk_run *r, tk_error *err)
         int rc = tk_curve_copy(r->escape.best, &curve, err);
         return rc ? rc : tk_schedule_restart(r, curve, false, r->escape.best_polish, err);
     }
-    if (r->escape.nlog == r->escape.log_capacity) {
-        size_t cap = r->escape.log_capacity ? 2 * r->escape.log_capacity : 8;
-        tk_escape *grown = realloc(r->escape.log, cap * sizeof *grown);
-        if (!grown)
-            return tk_error_set(err, TK_ENOMEM, "out of memory for the escapes");
-        r->escape.log = grown;
-        r->escape.log_capacity = cap;
-    }
     double amplitude = 0.0;
-    int rc = deformed_best(r, &curve, &amplitude, err);
-    if (rc)
-        return rc;
+    int fine = tk_escape_tries(r) - r->escape.explore_tries;
+    int rc = deformed(r, r->escape.best, r->escape.best_report.thickness, fine % 2, &curve,
+                      &amplitude, err);
+    tk_escape *e = rc ? NULL : log_entry(r, err);
+    if (!e) {
+        tk_curve_free(&curve);
+        return rc ? rc : TK_ENOMEM;
+    }
     r->escape.polishing = false;
     r->escape.coarse = NAN;
-    r->escape.log[r->escape.nlog++] = (tk_escape){
+    *e = (tk_escape){
         .step = r->life.latest.step,
         .from = r->escape.best_report.ropelength,
         .amplitude = amplitude,

@@ -163,6 +163,19 @@ struct tk_run {
         size_t coarse_vertices; /* that polygon's vertices */
         double best_coarse;  /* the same for the best's tightening */
         size_t best_coarse_vertices;
+        /* exploration: tries on the coarsest polygon alone, before the
+           run first refines from it */
+        tk_curve *explored;  /* the lowest plateau there so far, or NULL */
+        double explored_rope, explored_thickness;
+        int explore_tries;   /* logged among the tries, not counted
+                                against the escapes option's */
+        int explore_fails;   /* tries in a row that did not improve it */
+        bool explore_over;   /* the run has left exploring (or never
+                                explores: resumed, or no coarse level) */
+        bool explore_due;    /* before the next step: a deformation of the
+                                explored best, or (exploring over) it back */
+        bool explore_goes_on; /* exploring over, the explored try under
+                                 way goes on (lower than the lowest) */
         tk_escape *log;      /* one per try */
         size_t nlog, log_capacity;
         int improved;
@@ -373,6 +386,10 @@ int tk_schedule_fit(tk_run *r, tk_error *err);
  * its vertices, the schedule is at the final level and the polishing
  * level is `polish`; made feasible by scaling, type-checked. */
 int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_error *err);
+/* The same on the coarsest level before the final polygon is fixed (the
+ * escapes' exploration): `curve` resampled to that level's vertices at
+ * ropelength `rope`, or kept as it is with 0. */
+int tk_schedule_explore(tk_run *r, tk_curve *curve, double rope, tk_error *err);
 /* The fraction of the step or time budget spent (0 without one). */
 double tk_schedule_spent(const tk_run *r);
 /* The same at the step of report s. */

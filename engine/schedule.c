@@ -595,13 +595,37 @@ bool tk_schedule_share_spent(const tk_run *r)
     return spent >= (double)(levels - r->schedule.coarse_level + 1) / (double)(levels + 1);
 }
 
-int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_error *err)
+/* The run goes on from `curve` (taken), on the level set, resampled to
+ * `count` vertices: the start of a schedule, made feasible as a start is. */
+static int restart(tk_run *r, tk_curve *curve, size_t count, int polish, tk_error *err)
 {
     tk_curve_free(&r->shared.curve);
     r->shared.curve = curve;
     r->schedule.restarts++;
     r->schedule.share_from = tk_schedule_spent(r);
     r->schedule.move_on = false;
+    tk_measure m;
+    int rc = measure(curve, &m, err);
+    if (rc)
+        return rc;
+    /* a deformed curve is thinner: scaled to the tube, as at the start */
+    if (m.thickness < r->tau * (1.0 - tk_tolerance_overstep(r)))
+        tk_curve_scale(curve, r->opt.autoscale_margin * r->tau / m.thickness);
+    /* resample_to checks the type of what it makes */
+    bool resampled = count != curve->nvert;
+    rc = resampled ? resample_to(r, count, err) : tk_schedule_fit(r, err);
+    if (rc)
+        return rc;
+    r->schedule.polish_level = polish;
+    r->schedule.polish_from = r->life.nhistory;
+    r->schedule.resampled_from = r->life.nhistory;
+    r->schedule.resolved_at = r->life.latest.ropelength;
+    tk_stepping_reset(r);
+    return resampled ? TK_OK : tk_type_check(r, "an escape's deformation", err);
+}
+
+int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_error *err)
+{
     size_t count = curve->nvert;
     if (coarse && !(r->schedule.final_ropelength > 0.0))
         fix_final(r, reference_ropelength(r));
@@ -618,24 +642,14 @@ int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_
      * and ended with the best unpolished. */
     if (!coarse)
         r->schedule.coarse_level = 0;
-    tk_measure m;
-    int rc = measure(curve, &m, err);
-    if (rc)
-        return rc;
-    /* a deformed curve is thinner: scaled to the tube, as at the start */
-    if (m.thickness < r->tau * (1.0 - tk_tolerance_overstep(r)))
-        tk_curve_scale(curve, r->opt.autoscale_margin * r->tau / m.thickness);
-    /* resample_to checks the type of what it makes */
-    bool resampled = count != curve->nvert;
-    rc = resampled ? resample_to(r, count, err) : tk_schedule_fit(r, err);
-    if (rc)
-        return rc;
-    r->schedule.polish_level = coarse ? 0 : polish;
-    r->schedule.polish_from = r->life.nhistory;
-    r->schedule.resampled_from = r->life.nhistory;
-    r->schedule.resolved_at = r->life.latest.ropelength;
-    tk_stepping_reset(r);
-    return resampled ? TK_OK : tk_type_check(r, "an escape's deformation", err);
+    return restart(r, curve, count, coarse ? 0 : polish, err);
+}
+
+int tk_schedule_explore(tk_run *r, tk_curve *curve, double rope, tk_error *err)
+{
+    r->schedule.coarse_level = r->schedule.coarse_levels;
+    size_t count = rope > 0.0 ? level_count(r, rope) : curve->nvert;
+    return restart(r, curve, count, 0, err);
 }
 
 /* A loose curve is kept at the tube.  Shortening a curve that touches

@@ -168,6 +168,7 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
     r->type.checked_step = -1;
     r->escape.rng = opts->seed;
     r->escape.coarse = r->escape.best_coarse = NAN;
+    r->escape.explore_over = at != NULL; /* its exploration's best is not kept */
     rc = tk_nnls_new(&r->shared.nnls, err);
     if (!rc)
         rc = at ? tk_schedule_resume(r, start, at, err) : tk_schedule_start(r, start, err);

@@ -1548,25 +1548,42 @@ START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
     o.autoscale = true;
     o.resolution = 5;
     o.escapes = 2;
-    o.max_steps = 6000; /* the second escape starts before the last fifth */
+    o.max_steps = 9000; /* the second escape (after an explored one) starts before the last fifth */
     tk_run *run = NULL;
     tk_error err;
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
     size_t coarse = tk_run_curve(run)->nvert;
     ck_assert_uint_eq(coarse, (size_t)ceil(2.5 * m.ropelength));
-    while (tk_run_latest(run)->escapes < 2 && tk_run_latest(run)->step < o.max_steps)
+    size_t ne = 0, explored = 0;
+    const tk_escape *e = tk_run_escapes(run, &ne);
+    while (ne - explored < 2 && tk_run_latest(run)->step < o.max_steps) {
         ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
-    ck_assert_int_eq(tk_run_latest(run)->escapes, 2);
+        e = tk_run_escapes(run, &ne);
+        explored = ne > 0 && e[ne - 1].explored ? ne : explored;
+    }
+    ck_assert_uint_eq(ne - explored, 2);
     double reference = final_reference(run, m.ropelength);
     size_t final = (size_t)ceil(5 * reference), again = (size_t)ceil(2.5 * reference);
     size_t nh = 0;
     const tk_step_report *h = tk_run_history(run, &nh);
-    size_t restarts = 0, refinements = 0;
+    size_t restarts = 0, refinements = 0, plateau = 0;
+    double lowest = INFINITY;
     for (size_t i = 1; i < nh; i++) {
-        if (h[i].escapes > h[i - 1].escapes) {
+        int k = h[i].escapes - 1;
+        if (h[i].escapes > h[i - 1].escapes && e[k].explored) {
+            /* explored: the lowest curve's polygon, the first plateau's */
+            plateau = plateau ? plateau : h[i - 1].vertices;
+            lowest = fmin(lowest, k == 0 ? h[i - 1].ropelength : e[k - 1].coarse);
+            ck_assert_uint_eq(h[i].vertices, plateau);
+            ck_assert_uint_eq(refinements, 0);
+        } else if (h[i].escapes > h[i - 1].escapes) {
             /* an escape: back to the coarse level of the same reference */
             ck_assert_uint_eq(h[i].vertices, again);
             restarts++;
+        } else if (h[i].restarts > h[i - 1].restarts && k >= 0 && e[k].explored) {
+            /* exploring over: the lowest curve on its own ropelength's coarse polygon */
+            lowest = fmin(lowest, e[k].coarse);
+            ck_assert_uint_eq(h[i].vertices, (size_t)ceil(2.5 * lowest));
         } else if (h[i].vertices < h[i - 1].vertices) {
             /* the first coarse level following the ropelength down */
             ck_assert_uint_eq(h[i].vertices, (size_t)ceil(2.5 * h[i - 1].ropelength));
@@ -1582,6 +1599,7 @@ START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
            tk_run_latest(run)->step, refinements);
     ck_assert_uint_lt(final, (size_t)ceil(5 * m.ropelength) * 3 / 4);
     ck_assert_uint_eq(restarts, 2);
+    printf("explored tries: %zu; the lowest explored ropelength %.6f\n", explored, lowest);
     /* resumed during the second escape, it ends on the same polygon */
     tk_resume at;
     tk_run *second = interrupted(run, tk_run_latest(run)->step + 5, &at);
@@ -2076,7 +2094,8 @@ END_TEST
  * from the round torus at 200 vertices: every tightening's coarsest
  * polygon has 100.  The lineage is rebuilt from the history and the
  * escapes' log alone: the first tightening's last step before its first
- * refinement, then the coarse figure of each try that improved.  (A run
+ * refinement (the lowest explored curve's, put back), then the coarse
+ * figure of each try that improved; explored tries are never refined.  (A run
  * whose first tightening starts on the final polygon, as at 170 vertices,
  * where the torus is too long for a coarse level, has no lineage until a
  * try improves, and refines every try until then.) */
@@ -2090,7 +2109,8 @@ START_TEST(a_try_behind_on_its_coarsest_polygon_is_given_up_there)
     o.autoscale = true;
     o.vertices = 200;
     o.escapes = 8;
-    o.max_steps = 20000; /* the fourth try, at step 11,098, is refined */
+    o.seed = 3; /* seed 1's tries are all behind the lowest explored curve */
+    o.max_steps = 20000;
     tk_run *run = NULL;
     tk_error err;
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
@@ -2108,15 +2128,23 @@ START_TEST(a_try_behind_on_its_coarsest_polygon_is_given_up_there)
     ck_assert(!isnan(lineage));
     size_t given_up = 0, refined = 0;
     for (size_t k = 0; k < ne; k++) {
-        /* the try's steps: escapes counts the tries begun */
+        /* the try's steps: escapes counts the tries begun, and a restart
+         * that begins none (the best, or the lowest explored, put back)
+         * ends it */
         size_t first = nh, last = 0, on_final = 0;
         for (size_t i = 0; i < nh; i++)
-            if (h[i].escapes == (int)k + 1 && h[i].restarts == h[0].restarts + (int)k + 1) {
+            if (h[i].escapes == (int)k + 1 && (first == nh || h[i].restarts == h[first].restarts)) {
                 first = i < first ? i : first;
                 last = i;
                 on_final += h[i].vertices == o.vertices;
             }
         ck_assert_uint_lt(first, nh);
+        if (e[k].explored) {
+            /* judged among the explored (an_explored_try_...): never refined */
+            ck_assert_uint_eq(on_final, 0);
+            ck_assert(isnan(e[k].reached));
+            continue;
+        }
         bool ended = k + 1 < ne; /* the last can be cut short by the budget or the reserve */
         printf("try %zu: steps %ld-%ld, from %.6f, coarse %.6f against %.6f, %zu steps on the "
                "final polygon, reached %.6f\n", k + 1, h[first].step, h[last].step, e[k].from,
@@ -2151,6 +2179,63 @@ START_TEST(a_try_behind_on_its_coarsest_polygon_is_given_up_there)
 }
 END_TEST
 
+/* Exploration (escape.c): before the first refinement, tries deform the
+ * lowest curve found on the coarsest polygon and are judged there.  The
+ * figure-eight, disguised (seed 14, perturbation 0.01), at resolution 5:
+ * its coarse levels stop at 55.30 with kinks at the curvature bound,
+ * and its final polygon, refined from there, took 60,000 steps to come
+ * down.  With a budget of 16,000 steps the first explored try leaves
+ * that plateau for the tight knot's basin and the run ends within 0.2%
+ * of the best known 4_1 (42.09703, 400 vertices). */
+START_TEST(an_explored_try_leaves_a_coarse_trap)
+{
+    if (quick() && tkt_skip("an_explored_try_leaves_a_coarse_trap", LONG_RUN))
+        return;
+    tk_curve *c = NULL, *d = NULL;
+    ck_assert_int_eq(tk_generate_figure_eight(200, &c, NULL), TK_OK);
+    ck_assert_int_eq(tk_generate_disguise(c, 14, 0.01, &d, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 5;
+    o.max_steps = 16000;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(d, &o, &run, &err), TK_OK);
+    ck_assert_msg(tk_run_until(run, NULL, &err) == TK_OK, "%s", err.message);
+    size_t nh = 0, ne = 0;
+    const tk_step_report *h = tk_run_history(run, &nh);
+    const tk_escape *e = tk_run_escapes(run, &ne);
+    ck_assert_uint_gt(ne, 0);
+    ck_assert(e[0].explored);
+    /* the first tightening's plateau: its last step before the first try */
+    size_t at = 1;
+    while (at < nh && h[at].escapes == 0)
+        at++;
+    ck_assert_uint_lt(at, nh);
+    double plateau = h[at - 1].ropelength;
+    ck_assert_int_eq(h[at - 1].step, e[0].step);
+    ck_assert(e[0].from == plateau);
+    /* an explored try: on the plateau's polygon, judged where it leaves it */
+    ck_assert_uint_eq(h[at].vertices, h[at - 1].vertices);
+    size_t left = at;
+    while (left < nh && h[left].vertices == h[at].vertices && h[left].restarts == h[at].restarts)
+        left++;
+    ck_assert_uint_lt(left, nh);
+    ck_assert(e[0].coarse == h[left - 1].ropelength);
+    ck_assert(isnan(e[0].reached));
+    ck_assert(e[0].coarse < 0.9 * plateau && e[0].improved);
+    const tk_step_report *end = tk_run_latest(run);
+    double excess = end->ropelength / 42.09703 - 1.0;
+    printf("disguised figure-eight at resolution 5: plateau %.5f, explored try left it at %.5f; "
+           "ends at %.6f (%+.3f%%, %zu vertices), %zu tries\n", plateau, e[0].coarse,
+           end->ropelength, 100.0 * excess, end->vertices, ne);
+    ck_assert_msg(fabs(excess) < 2e-3, "%.6f", end->ropelength);
+    tk_run_free(&run);
+    tk_curve_free(&d);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("tighten");
@@ -2170,6 +2255,7 @@ int main(void)
     tcase_add_test(tc, a_best_put_back_is_polished_not_replayed);
     tcase_add_test(tc, a_run_that_tried_no_escape_returns_its_best);
     tcase_add_test(tc, a_try_behind_on_its_coarsest_polygon_is_given_up_there);
+    tcase_add_test(tc, an_explored_try_leaves_a_coarse_trap);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
     tcase_add_test(tc, vertices_option_ends_at_exactly_that_count);

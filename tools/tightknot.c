@@ -232,8 +232,10 @@ static const char tighten_help_end[] =
     "                          used), invariants: {start, result}, the knot or\n"
     "                          link type of the input and of the result, as in\n"
     "                          'tightknot info --json', escapes: [{step,\n"
-    "                          from, amplitude, coarse, reached, improved}],\n"
-    "                          one per escape tried, and recovery: {undone_steps,\n"
+    "                          from, amplitude, coarse, reached, improved,\n"
+    "                          explored}], one per escape tried (explored: on\n"
+    "                          the coarsest polygon alone, before the first\n"
+    "                          refinement), and recovery: {undone_steps,\n"
     "                          rescales, largest_rescale, bent_corrections,\n"
     "                          length_steps}, error recovery's last resorts\n"
     "                          and the steps judged by their length alone\n"
@@ -925,6 +927,14 @@ static int cmd_tighten(int argc, char **argv)
         for (size_t k = 0; k < ne; k++) {
             printf("  escape %zu after step %ld: from %.9g, deformed by %.3g diameters, ", k + 1,
                    e[k].step, e[k].from, e[k].amplitude);
+            if (e[k].explored) {
+                if (isnan(e[k].coarse))
+                    printf("explored, stopped on the coarsest polygon\n");
+                else
+                    printf("explored: coarsest polygon left at %.9g%s\n", e[k].coarse,
+                           e[k].improved ? " (better)" : "");
+                continue;
+            }
             if (!isnan(e[k].coarse))
                 printf("coarsest polygon left at %.9g, ", e[k].coarse);
             if (isnan(e[k].reached))

@@ -119,7 +119,9 @@
       "(or has crawled there for a fifth of the budget) before the last fifth of the "       \
       "budget, the best curve so far is deformed at random (every second time loosened "     \
       "many times over) and tightened again; the last fifth polishes the best curve; the "   \
-      "result is the best curve found (0: none)")                                            \
+      "result is the best curve found; before that, in the first quarter of the budget, "    \
+      "as many tries again explore the coarsest polygon alone, from the lowest curve found " \
+      "there (0: none)")                                                                     \
     X(seed, SEED, 1, 0, 9007199254740992.0, "seed",                                          \
       "of the escapes' random deformations: the same seed, the same run")
 
@@ -231,7 +233,10 @@ tk_stop_reason tk_run_stop_reason(const tk_run *r);
  * polygon (NAN while under way, or when the run stopped or gave it up
  * first: a try whose coarsest polygon ended above the best's is given up
  * there, and the last fifth of the budget polishes the best curve, and
- * what that reaches is no try's). */
+ * what that reaches is no try's).  An explored try, made before the run
+ * first left its coarsest polygon, deforms the lowest curve found there
+ * and is judged there alone: `from` and `improved` compare its coarsest
+ * polygon's end with that curve's, and it never reaches the final one. */
 typedef struct tk_escape {
     long step;          /* the step after which the deformation was made */
     double from;        /* the best ropelength when it started */
@@ -239,7 +244,8 @@ typedef struct tk_escape {
     double coarse;      /* its coarsest polygon's last ropelength (NAN:
                            none, or not left yet) */
     double reached;
-    bool improved;      /* reached < from */
+    bool improved;      /* reached < from (explored: coarse < from) */
+    bool explored;      /* on the coarsest polygon only */
 } tk_escape;
 
 const tk_escape *tk_run_escapes(const tk_run *r, size_t *count);
