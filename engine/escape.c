@@ -357,6 +357,7 @@ static int explore_next(tk_run *r, tk_error *err)
 {
     tk_curve *curve = NULL;
     int rc;
+    assert(r->escape.explored);
     if (r->escape.explore_over) {
         rc = tk_curve_copy(r->escape.explored, &curve, err);
         tk_curve_free(&r->escape.explored);
