@@ -2110,7 +2110,7 @@ START_TEST(a_try_behind_on_its_coarsest_polygon_is_given_up_there)
     o.vertices = 200;
     o.escapes = 8;
     o.seed = 3; /* seed 1's tries are all behind the lowest explored curve */
-    o.max_steps = 20000;
+    o.max_steps = 12000;
     tk_run *run = NULL;
     tk_error err;
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
