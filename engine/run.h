@@ -176,6 +176,9 @@ struct tk_run {
                                 explored best, or (exploring over) it back */
         bool explore_goes_on; /* exploring over, the explored try under
                                  way goes on (lower than the lowest) */
+        bool explore_resolve; /* before the next step: the first plateau
+                                 put back on its own ropelength's polygon */
+        bool explore_resolved;
         tk_escape *log;      /* one per try */
         size_t nlog, log_capacity;
         int improved;
@@ -390,6 +393,8 @@ int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_
  * escapes' exploration): `curve` resampled to that level's vertices at
  * ropelength `rope`, or kept as it is with 0. */
 int tk_schedule_explore(tk_run *r, tk_curve *curve, double rope, tk_error *err);
+/* The vertices of the coarsest level at ropelength `rope`. */
+size_t tk_schedule_coarsest_count(tk_run *r, double rope);
 /* The fraction of the step or time budget spent (0 without one). */
 double tk_schedule_spent(const tk_run *r);
 /* The same at the step of report s. */

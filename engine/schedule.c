@@ -645,10 +645,19 @@ int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_
     return restart(r, curve, count, coarse ? 0 : polish, err);
 }
 
+size_t tk_schedule_coarsest_count(tk_run *r, double rope)
+{
+    int level = r->schedule.coarse_level;
+    r->schedule.coarse_level = r->schedule.coarse_levels;
+    size_t count = level_count(r, rope);
+    r->schedule.coarse_level = level;
+    return count;
+}
+
 int tk_schedule_explore(tk_run *r, tk_curve *curve, double rope, tk_error *err)
 {
+    size_t count = rope > 0.0 ? tk_schedule_coarsest_count(r, rope) : curve->nvert;
     r->schedule.coarse_level = r->schedule.coarse_levels;
-    size_t count = rope > 0.0 ? level_count(r, rope) : curve->nvert;
     return restart(r, curve, count, 0, err);
 }
 
