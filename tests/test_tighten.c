@@ -2095,7 +2095,7 @@ END_TEST
  * polygon has 100.  The lineage is rebuilt from the history and the
  * escapes' log alone: the first tightening's last step before its first
  * refinement (the lowest explored curve's, put back), then the coarse
- * figure of each try that improved; explored tries are never refined.  (A run
+ * figure of each try that improved; explored tries reach nothing.  (A run
  * whose first tightening starts on the final polygon, as at 170 vertices,
  * where the torus is too long for a coarse level, has no lineage until a
  * try improves, and refines every try until then.) */
@@ -2140,8 +2140,8 @@ START_TEST(a_try_behind_on_its_coarsest_polygon_is_given_up_there)
             }
         ck_assert_uint_lt(first, nh);
         if (e[k].explored) {
-            /* judged among the explored (an_explored_try_...): never refined */
-            ck_assert_uint_eq(on_final, 0);
+            /* judged among the explored (an_explored_try_...), never as a
+             * try on the final polygon */
             ck_assert(isnan(e[k].reached));
             continue;
         }
