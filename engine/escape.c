@@ -287,10 +287,10 @@ static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far,
  * reckoned from a looser curve and can be finer than its own ropelength's
  * coarsest level: catalogue 8.19 at resolution 5 stopped at 61.13 on 203
  * vertices, where 153 are its own, and its tries there (a far one took
- * 10 s) explored for the whole quarter (120 s).  More than EXPLORE_RESOLVE
- * finer, it is put back on its own polygon first and its plateau there
- * found again: the tries and the lowest then compare on one polygon, and
- * 8.19's three tries ended exploring at 17.7 s. */
+ * 10 s) explored for the whole quarter of a 120 s run.  More than
+ * EXPLORE_RESOLVE finer, it is put back on its own polygon first and its
+ * plateau there found again: the tries and the lowest then compare on one
+ * polygon, and 8.19's three tries ended exploring at 17.7 s. */
 #define EXPLORE_SHARE 0.25
 #define EXPLORE_FAILS 3
 #define EXPLORE_GAIN 1e-4
