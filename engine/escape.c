@@ -338,15 +338,17 @@ static bool explore(tk_run *r)
         r->escape.explored_rope = s->ropelength;
         r->escape.explored_thickness = s->thickness;
     }
+    r->escape.explore_pending = TK_EXPLORE_TRY;
     if (resolve) {
-        r->escape.explore_resolve = true;
+        r->escape.explore_resolved = true;
+        r->escape.explore_pending = TK_EXPLORE_BACK;
     } else if (!explore_more(r)) {
         r->escape.explore_over = true;
+        r->escape.explore_pending = TK_EXPLORE_BACK;
         if (!(s->ropelength > r->escape.explored_rope))
-            return false;
+            r->escape.explore_pending = TK_EXPLORE_NONE;
     }
-    r->escape.explore_due = true;
-    return true;
+    return r->escape.explore_pending != TK_EXPLORE_NONE;
 }
 
 /* A new entry at the end of the escapes' log, or NULL (*err set). */
@@ -372,10 +374,8 @@ static int explore_next(tk_run *r, tk_error *err)
     tk_curve *curve = NULL;
     int rc;
     assert(r->escape.explored);
-    if (r->escape.explore_over || r->escape.explore_resolve) {
+    if (r->escape.explore_pending == TK_EXPLORE_BACK) {
         /* (resolved, the first plateau is found again on that polygon) */
-        r->escape.explore_resolved = r->escape.explore_resolve;
-        r->escape.explore_resolve = false;
         rc = tk_curve_copy(r->escape.explored, &curve, err);
         tk_curve_free(&r->escape.explored);
         return rc ? rc : tk_schedule_explore(r, curve, r->escape.explored_rope, err);
@@ -444,18 +444,19 @@ int tk_escape_before_step(tk_run *r, tk_error *err)
 {
     if (r->opt.escapes > 0)
         judge_coarse(r);
-    if (!r->escape.explore_over && r->escape.explore_tries > 0 && !r->escape.explore_due &&
-        !(tk_schedule_spent(r) < EXPLORE_SHARE)) {
+    if (!r->escape.explore_over && r->escape.explore_tries > 0 &&
+        r->escape.explore_pending == TK_EXPLORE_NONE && !(tk_schedule_spent(r) < EXPLORE_SHARE)) {
         /* the exploring share spent with a try under way: the lowest goes
          * on, or the try if it is lower already (and judged where it
          * leaves its coarsest polygon, as the lowest) */
         r->escape.explore_over = true;
         r->escape.explore_goes_on = r->life.latest.ropelength < r->escape.explored_rope;
-        r->escape.explore_due = !r->escape.explore_goes_on;
+        r->escape.explore_pending = r->escape.explore_goes_on ? TK_EXPLORE_NONE : TK_EXPLORE_BACK;
     }
-    if (r->escape.explore_due) {
-        r->escape.explore_due = false;
-        return explore_next(r, err);
+    if (r->escape.explore_pending != TK_EXPLORE_NONE) {
+        int rc = explore_next(r, err);
+        r->escape.explore_pending = TK_EXPLORE_NONE;
+        return rc;
     }
     if (!r->escape.due)
         return TK_OK;

@@ -172,13 +172,16 @@ struct tk_run {
         int explore_fails;   /* tries in a row that did not improve it */
         bool explore_over;   /* the run has left exploring (or never
                                 explores: resumed, or no coarse level) */
-        bool explore_due;    /* before the next step: a deformation of the
-                                explored best, or (exploring over) it back */
+        enum {               /* before the next step: */
+            TK_EXPLORE_NONE,
+            TK_EXPLORE_TRY,  /* a deformation of the lowest */
+            TK_EXPLORE_BACK  /* the lowest back, on its own ropelength's
+                                coarsest polygon (exploring over, or the
+                                first plateau resolved) */
+        } explore_pending;
         bool explore_goes_on; /* exploring over, the explored try under
                                  way goes on (lower than the lowest) */
-        bool explore_resolve; /* before the next step: the first plateau
-                                 put back on its own ropelength's polygon */
-        bool explore_resolved;
+        bool explore_resolved; /* the first plateau was put back once */
         tk_escape *log;      /* one per try */
         size_t nlog, log_capacity;
         int improved;
