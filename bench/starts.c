@@ -14,8 +14,14 @@
  * (default 600), and judged against the atlas's value at that count:
  * "within.1%" and "at.atlas" (at or below it).
  *
+ * With --seeds K each start runs K times, with the escapes' seeds 1 to K,
+ * and a summary gives each start's lowest, median and highest final
+ * ropelength and how many of its runs came within 0.1% of the best known
+ * value (at or below the atlas's with --atlas): one run says little of
+ * how often the escapes find the tight basin.
+ *
  *   bench/starts [CATALOGUE_DIR] [--seconds S] [--resolution R] [--jobs N]
- *                [--atlas] [--list] [START ...]
+ *                [--atlas] [--seeds K] [--escapes E] [--list] [START ...]
  */
 #include <math.h>
 #include <pthread.h>
@@ -133,8 +139,12 @@ typedef struct bench {
     const char *dir;
     double seconds, resolution;
     bool atlas;
+    long seeds;   /* runs of each start, seeds 1 to seeds */
+    long escapes; /* the escapes option; < 0: its default */
     const start *todo[NSTARTS];
-    size_t ntodo, next;
+    size_t ntodo, next; /* runs: next / seeds is the start, next % seeds + 1 its seed */
+    double *rope;       /* each run's final ropelength, NAN if it failed */
+    bool *close;        /* each run within the summary's margin */
     pthread_mutex_t lock;
 } bench;
 
@@ -146,14 +156,16 @@ static void describe(char *buf, size_t size, double t)
         snprintf(buf, size, "%.1fs", t);
 }
 
-static void run_start(bench *b, const start *s)
+/* One run of start s with the given seed; its row printed, its figures
+ * kept at b->rope[slot] and b->close[slot]. */
+static void run_start(bench *b, const start *s, unsigned long long seed, size_t slot)
 {
     tk_error err;
     char line[512];
     tk_curve *c = make_start(s, b->dir, &err);
     if (!c) {
-        snprintf(line, sizeof line, "%-9s %-7s start failed: %s\n", s->name, s->type,
-                 err.message);
+        snprintf(line, sizeof line, "%-9s %-7s %4llu start failed: %s\n", s->name, s->type,
+                 seed, err.message);
         pthread_mutex_lock(&b->lock);
         fputs(line, stdout);
         fflush(stdout);
@@ -162,6 +174,9 @@ static void run_start(bench *b, const start *s)
     }
     tk_options o = TK_OPTIONS_INIT;
     o.autoscale = true;
+    o.seed = seed;
+    if (b->escapes >= 0)
+        o.escapes = (int)b->escapes;
     o.resolution = b->resolution;
     o.max_seconds = b->seconds;
     double best = s->best, margin[2] = {0.005, 0.001};
@@ -174,7 +189,8 @@ static void run_start(bench *b, const start *s)
             margin[1] = 0.0;
         }
     if (b->atlas && o.vertices == 0) {
-        snprintf(line, sizeof line, "%-9s %-7s no atlas polygon of this type\n", s->name, s->type);
+        snprintf(line, sizeof line, "%-9s %-7s %4llu no atlas polygon of this type\n", s->name,
+                 s->type, seed);
         pthread_mutex_lock(&b->lock);
         fputs(line, stdout);
         fflush(stdout);
@@ -188,7 +204,8 @@ static void run_start(bench *b, const start *s)
     if (rc == TK_OK)
         rc = tk_run_until(run, &why, &err);
     if (!run) {
-        snprintf(line, sizeof line, "%-9s %-7s refused: %s\n", s->name, s->type, err.message);
+        snprintf(line, sizeof line, "%-9s %-7s %4llu refused: %s\n", s->name, s->type, seed,
+                 err.message);
     } else {
         const tk_step_report *last = tk_run_latest(run);
         size_t nh = 0, ne = 0;
@@ -216,10 +233,14 @@ static void run_start(bench *b, const start *s)
         if (t.rescales > 0)
             snprintf(rescaled, sizeof rescaled, "%ld<%.1e", t.rescales, t.largest_rescale);
         snprintf(line, sizeof line,
-                 "%-9s %-7s %8zu %8ld %11.5f %10s %9s %9s %5zu %5zu %6ld %11s  %s%s%s\n", s->name,
-                 s->type, last->vertices, last->step, last->ropelength, excess, w5, w1, ne,
-                 improved, t.undone_steps, rescaled, tk_stop_reason_name(why), rc ? ": " : "",
-                 rc ? err.message : "");
+                 "%-9s %-7s %4llu %8zu %8ld %11.5f %10s %9s %9s %5zu %5zu %6ld %11s  %s%s%s\n",
+                 s->name, s->type, seed, last->vertices, last->step, last->ropelength, excess, w5,
+                 w1, ne, improved, t.undone_steps, rescaled, tk_stop_reason_name(why),
+                 rc ? ": " : "", rc ? err.message : "");
+        if (rc == TK_OK) {
+            b->rope[slot] = last->ropelength;
+            b->close[slot] = last->ropelength <= best * (1.0 + margin[1]);
+        }
     }
     pthread_mutex_lock(&b->lock);
     fputs(line, stdout);
@@ -234,24 +255,66 @@ static void *worker(void *arg)
     bench *b = arg;
     for (;;) {
         pthread_mutex_lock(&b->lock);
-        size_t k = b->next < b->ntodo ? b->next++ : SIZE_MAX;
+        size_t runs = b->ntodo * (size_t)b->seeds;
+        size_t k = b->next < runs ? b->next++ : SIZE_MAX;
         pthread_mutex_unlock(&b->lock);
         if (k == SIZE_MAX)
             return NULL;
-        run_start(b, b->todo[k]);
+        run_start(b, b->todo[k / (size_t)b->seeds], (unsigned long long)(k % (size_t)b->seeds) + 1,
+                  k);
     }
+}
+
+static int by_value(const void *x, const void *y)
+{
+    double a = *(const double *)x, c = *(const double *)y;
+    return (a > c) - (a < c);
+}
+
+/* Each start's runs over the seeds: lowest, median and highest final
+ * ropelength (runs that failed left out) and how many came close. */
+static void summary(const bench *b)
+{
+    size_t seeds = (size_t)b->seeds;
+    double *sorted = malloc(seeds * sizeof *sorted);
+    if (!sorted)
+        return;
+    printf("\n%-9s %-7s %5s %11s %11s %11s  %s\n", "start", "type", "runs", "lowest", "median",
+           "highest", b->atlas ? "at.atlas" : "within.1%");
+    for (size_t s = 0; s < b->ntodo; s++) {
+        size_t n = 0, close = 0;
+        for (size_t k = s * seeds; k < (s + 1) * seeds; k++) {
+            if (!isnan(b->rope[k]))
+                sorted[n++] = b->rope[k];
+            close += b->close[k];
+        }
+        if (n == 0) {
+            printf("%-9s %-7s %5zu %11s %11s %11s  -\n", b->todo[s]->name, b->todo[s]->type, n,
+                   "-", "-", "-");
+            continue;
+        }
+        qsort(sorted, n, sizeof *sorted, by_value);
+        double median = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+        char count[32] = "-";
+        if (isfinite(b->todo[s]->best))
+            snprintf(count, sizeof count, "%zu of %zu", close, n);
+        printf("%-9s %-7s %5zu %11.5f %11.5f %11.5f  %s\n", b->todo[s]->name, b->todo[s]->type,
+               n, sorted[0], median, sorted[n - 1], count);
+    }
+    free(sorted);
 }
 
 int main(int argc, char **argv)
 {
-    bench b = {.dir = "../shared/catalogue", .seconds = 120.0, .resolution = 5.0};
+    bench b = {.dir = "../shared/catalogue", .seconds = 120.0, .resolution = 5.0, .seeds = 1,
+               .escapes = -1};
     bool seconds_given = false;
     long jobs = 2;
     pthread_mutex_init(&b.lock, NULL);
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             printf("usage: starts [CATALOGUE_DIR] [--seconds S] [--resolution R] [--jobs N]\n"
-                   "              [--atlas] [--list] [START ...]\n"
+                   "              [--atlas] [--seeds K] [--escapes E] [--list] [START ...]\n"
                    "Tightens each start (default: all; --list names them) at resolution R\n"
                    "(default 5) for S seconds (default 120), N at a time (default 2), and\n"
                    "prints its final ropelength, its excess over the best known value and\n"
@@ -259,7 +322,12 @@ int main(int argc, char **argv)
                    "the steps error recovery undid and its rescales of the whole curve\n"
                    "(count<largest factor - 1).\n"
                    "--atlas: each at the atlas's vertex count of its type instead, for S\n"
-                   "seconds (default 600), against the atlas's value.\n");
+                   "seconds (default 600), against the atlas's value.\n"
+                   "--seeds K: each start K times, with the escapes' seeds 1 to K (default\n"
+                   "1), then each start's lowest, median and highest ropelength and how\n"
+                   "many runs came within 0.1%% of the best known value (with --atlas: at\n"
+                   "or below the atlas's).\n"
+                   "--escapes E: the tighten option (default its own, 8).\n");
             return 0;
         } else if (strcmp(argv[i], "--atlas") == 0) {
             b.atlas = true;
@@ -275,6 +343,18 @@ int main(int argc, char **argv)
             b.resolution = strtod(argv[++i], NULL);
         } else if (strcmp(argv[i], "--jobs") == 0 && i + 1 < argc) {
             jobs = strtol(argv[++i], NULL, 10);
+        } else if (strcmp(argv[i], "--seeds") == 0 && i + 1 < argc) {
+            b.seeds = strtol(argv[++i], NULL, 10);
+            if (b.seeds < 1 || b.seeds > 1000) {
+                fprintf(stderr, "starts: --seeds takes 1 to 1000\n");
+                return 2;
+            }
+        } else if (strcmp(argv[i], "--escapes") == 0 && i + 1 < argc) {
+            b.escapes = strtol(argv[++i], NULL, 10);
+            if (b.escapes < 0 || b.escapes > 1000) {
+                fprintf(stderr, "starts: --escapes takes 0 to 1000\n");
+                return 2;
+            }
         } else if (strchr(argv[i], '/') || strcmp(argv[i], ".") == 0) {
             b.dir = argv[i];
         } else {
@@ -303,14 +383,28 @@ int main(int argc, char **argv)
         printf("starts at resolution %g, %.0f s each, %ld at a time; excess over the best known "
                "value; within: first time on the final polygon\n\n",
                b.resolution, b.seconds, jobs);
-    printf("%-9s %-7s %8s %8s %11s %10s %9s %9s %5s %5s %6s %11s  %s\n", "start", "type",
-           "vertices", "steps", "ropelength", "excess", b.atlas ? "within.1%" : "within.5%",
+    printf("%-9s %-7s %4s %8s %8s %11s %10s %9s %9s %5s %5s %6s %11s  %s\n", "start", "type",
+           "seed", "vertices", "steps", "ropelength", "excess", b.atlas ? "within.1%" : "within.5%",
            b.atlas ? "at.atlas" : "within.1%", "esc", "impr", "undone", "rescaled", "stop");
+    fflush(stdout);
+    size_t runs = b.ntodo * (size_t)b.seeds;
+    b.rope = malloc(runs * sizeof *b.rope);
+    b.close = calloc(runs, sizeof *b.close);
+    if (!b.rope || !b.close) {
+        fprintf(stderr, "starts: out of memory\n");
+        return 1;
+    }
+    for (size_t k = 0; k < runs; k++)
+        b.rope[k] = NAN;
     pthread_t th[64];
     for (long k = 0; k < jobs; k++)
         pthread_create(&th[k], NULL, worker, &b);
     for (long k = 0; k < jobs; k++)
         pthread_join(th[k], NULL);
+    if (b.seeds > 1)
+        summary(&b);
+    free(b.rope);
+    free(b.close);
     pthread_mutex_destroy(&b.lock);
     return 0;
 }
