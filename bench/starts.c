@@ -304,6 +304,17 @@ static void summary(const bench *b)
     free(sorted);
 }
 
+/* *out = text as a whole number within [least, most]; false if it is not. */
+static bool count_arg(const char *text, long least, long most, long *out)
+{
+    char *end;
+    long v = strtol(text, &end, 10);
+    if (end == text || *end != '\0' || v < least || v > most)
+        return false;
+    *out = v;
+    return true;
+}
+
 int main(int argc, char **argv)
 {
     bench b = {.dir = "../shared/catalogue", .seconds = 120.0, .resolution = 5.0, .seeds = 1,
@@ -327,7 +338,7 @@ int main(int argc, char **argv)
                    "1), then each start's lowest, median and highest ropelength and how\n"
                    "many runs came within 0.1%% of the best known value (with --atlas: at\n"
                    "or below the atlas's).\n"
-                   "--escapes E: the tighten option (default its own, 8).\n");
+                   "--escapes E: the tighten option (default: tighten's).\n");
             return 0;
         } else if (strcmp(argv[i], "--atlas") == 0) {
             b.atlas = true;
@@ -344,14 +355,12 @@ int main(int argc, char **argv)
         } else if (strcmp(argv[i], "--jobs") == 0 && i + 1 < argc) {
             jobs = strtol(argv[++i], NULL, 10);
         } else if (strcmp(argv[i], "--seeds") == 0 && i + 1 < argc) {
-            b.seeds = strtol(argv[++i], NULL, 10);
-            if (b.seeds < 1 || b.seeds > 1000) {
+            if (!count_arg(argv[++i], 1, 1000, &b.seeds)) {
                 fprintf(stderr, "starts: --seeds takes 1 to 1000\n");
                 return 2;
             }
         } else if (strcmp(argv[i], "--escapes") == 0 && i + 1 < argc) {
-            b.escapes = strtol(argv[++i], NULL, 10);
-            if (b.escapes < 0 || b.escapes > 1000) {
+            if (!count_arg(argv[++i], 0, 1000, &b.escapes)) {
                 fprintf(stderr, "starts: --escapes takes 0 to 1000\n");
                 return 2;
             }
