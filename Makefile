@@ -169,7 +169,7 @@ $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIB)
 # every core unless make was given -j.
 TEST_JOBS := $(if $(filter -j%,$(MAKEFLAGS)),,-j$(shell nproc 2>/dev/null || echo 1))
 test: deps
-	$(Q)$(MAKE) --no-print-directory $(TEST_JOBS) all tests-bin
+	$(Q)$(MAKE) --no-print-directory $(TEST_JOBS) all tests-bin $(BENCH_BIN) lint headers
 	$(Q)$(MAKE) --no-print-directory $(TEST_JOBS) SANITIZE=1 all tests-bin
 	$(Q)$(MAKE) --no-print-directory $(TEST_JOBS) SANITIZE=thread build/tsan/tightknotd build/tsan/tightknot
 	$(Q)./tests/run-all.sh $(BUILD) build/asan $(CATALOGUE)

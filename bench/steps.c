@@ -167,7 +167,7 @@ int main(int argc, char **argv)
         } else if (strcmp(argv[i], "--curve") == 0 && i + 1 < argc) {
             curve = argv[++i];
         } else if (strcmp(argv[i], "--level") == 0 && i + 1 < argc) {
-            level = atoi(argv[++i]);
+            level = (int)strtol(argv[++i], NULL, 10);
         } else if (strcmp(argv[i], "--settle") == 0 && i + 1 < argc) {
             settle = strtol(argv[++i], NULL, 10);
         } else if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
