@@ -141,7 +141,7 @@ typedef struct tk_options {
  * resolution: runs larger are refused (TK_ELIMIT).  A run's memory grows
  * with its vertices and contacts: measured peaks of 360 MB for 1,000,000
  * vertices before any contact, 145 to 244 MB for the trefoil at 2,400
- * vertices in contact over 30 minutes (README).  A knot that large in
+ * vertices in contact over 30 minutes (bench/FIGURES.md).  A knot that large in
  * contact was not measured. */
 #define TK_RUN_MAX_VERTICES 1000000
 
