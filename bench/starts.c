@@ -16,7 +16,7 @@
  *
  * With --seeds K each start runs K times, with the escapes' seeds 1 to K,
  * and a summary gives each start's lowest, median and highest final
- * ropelength and how many of its runs came within 0.1% of the best known
+ * ropelength and how many of its runs ended within 0.1% of the best known
  * value (at or below the atlas's with --atlas): one run says little of
  * how often the escapes find the tight basin.
  *
@@ -272,7 +272,7 @@ static int by_value(const void *x, const void *y)
 }
 
 /* Each start's runs over the seeds: lowest, median and highest final
- * ropelength (runs that failed left out) and how many came close. */
+ * ropelength (runs that failed left out) and how many ended close. */
 static void summary(const bench *b)
 {
     size_t seeds = (size_t)b->seeds;
@@ -336,7 +336,7 @@ int main(int argc, char **argv)
                    "seconds (default 600), against the atlas's value.\n"
                    "--seeds K: each start K times, with the escapes' seeds 1 to K (default\n"
                    "1), then each start's lowest, median and highest ropelength and how\n"
-                   "many runs came within 0.1%% of the best known value (with --atlas: at\n"
+                   "many runs ended within 0.1%% of the best known value (with --atlas: at\n"
                    "or below the atlas's).\n"
                    "--escapes E: the tighten option (default: tighten's).\n");
             return 0;
