@@ -339,18 +339,24 @@ int tk_schedule_fit(tk_run *r, tk_error *err)
     return TK_OK;
 }
 
-/* The levels a run starts with (prepare_curve); the start's ropelength
- * is known. */
-static int coarse_levels(const tk_run *r)
+/* The coarse levels below a final polygon of `resolution` vertices per
+ * unit ropelength. */
+static int levels_below(const tk_run *r, double resolution)
 {
     const tk_options *o = &r->opt;
-    double resolution = resolution_final(r);
     int level = 0;
     if (resolution > 0.0 && o->coarse_to_fine && o->snapshot_every == 0)
         while (level < MAX_COARSE_LEVELS &&
                ldexp(resolution, -(level + 1)) >= COARSEST_RESOLUTION)
             level++;
     return level;
+}
+
+/* The levels a run starts with (prepare_curve); the start's ropelength
+ * is known. */
+static int coarse_levels(const tk_run *r)
+{
+    return levels_below(r, resolution_final(r));
 }
 
 /* Fixes the ropelength the final polygon is reckoned from: when the run
@@ -452,6 +458,11 @@ int tk_schedule_resume(tk_run *r, const tk_curve *curve, const tk_resume *at, tk
     r->schedule.start_ropelength = at->start_ropelength;
     r->schedule.final_ropelength = at->final_ropelength;
     r->schedule.coarse_levels = coarse_levels(r);
+    /* late levels (coarsen_late) are reckoned from a ropelength the place
+     * does not keep: the level it is at is the most it can have had */
+    if (r->opt.vertices > 0 && !(at->final_ropelength > 0.0) &&
+        at->coarse_level > r->schedule.coarse_levels && at->coarse_level <= MAX_COARSE_LEVELS)
+        r->schedule.coarse_levels = at->coarse_level;
     if (at->coarse_level > r->schedule.coarse_levels)
         return tk_error_set(err, TK_EINVAL,
                             "the run resumes at coarse level %d, but its options have %d",
@@ -682,6 +693,30 @@ static void keep_at_tube(tk_run *r)
     tk_curve_scale(r->shared.curve, r->opt.autoscale_margin * r->tau / s->thickness);
 }
 
+/* With the vertices option a start too loose for a coarse level (fewer
+ * than 2 x COARSEST_RESOLUTION vertices per unit of its ropelength)
+ * starts on the final polygon, and gets the coarse levels its ropelength
+ * allows once it has fallen that far, before the final polygon is first
+ * reached.  Without them Lissajous 6_1 L(3,2,5) (ropelength 429) at 480
+ * vertices spent the first 120 s of its 600 coming down to 57.10 on 480
+ * vertices, and its explored tries (escape.c) began after that; with them
+ * it was on 240 vertices after 3.7 s, at 57.15 after 25 s, and its tries
+ * had explored that level and reached 56.80 by 57 s. */
+static int coarsen_late(tk_run *r, double rope, tk_error *err)
+{
+    const tk_options *o = &r->opt;
+    if (!(o->vertices > 0) || r->schedule.final_ropelength > 0.0 ||
+        r->schedule.coarse_levels > 0 || r->schedule.restarts > 0 || !(rope > 0.0) ||
+        !isfinite(rope))
+        return TK_OK;
+    int levels = levels_below(r, (double)o->vertices / rope);
+    if (levels == 0)
+        return TK_OK;
+    r->schedule.coarse_level = r->schedule.coarse_levels = levels;
+    r->schedule.share_from = tk_schedule_spent(r);
+    return resample_to(r, level_count(r, rope), err);
+}
+
 /* Re-resolution during the run: the start was resampled to `resolution`
  * vertices per unit of ropelength, and as the knot tightens that count
  * grows finer than asked for.  Finer than needed costs twice: every step
@@ -700,6 +735,9 @@ int tk_schedule_before_step(tk_run *r, tk_error *err)
     keep_at_tube(r);
     if (r->schedule.move_on)
         return refine(r, err);
+    int rc = coarsen_late(r, rope, err);
+    if (rc)
+        return rc;
     double fraction = o->re_resolve > 0.0 || tk_schedule_final(r) ? o->re_resolve
                                                                    : COARSE_RE_RESOLVE;
     if (!(fraction > 0.0) || !(o->resolution > 0.0) || !isfinite(rope))
