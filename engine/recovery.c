@@ -49,6 +49,7 @@ void tk_recovery_free(tk_run *r)
     free(r->recovery.du);
     free(r->recovery.before);
     free(r->recovery.checked);
+    free(r->recovery.held);
 }
 
 int tk_recovery_fit(tk_run *r, size_t vertices, tk_error *err)
@@ -56,11 +57,13 @@ int tk_recovery_fit(tk_run *r, size_t vertices, tk_error *err)
     free(r->recovery.du);
     free(r->recovery.before);
     free(r->recovery.checked);
+    free(r->recovery.held);
+    r->recovery.held = calloc(3 * vertices, sizeof *r->recovery.held);
     r->recovery.du = calloc(3 * vertices, sizeof *r->recovery.du);
     r->recovery.before = calloc(3 * vertices, sizeof *r->recovery.before);
     r->recovery.checked = calloc(3 * vertices, sizeof *r->recovery.checked);
     r->recovery.checked_vertices = 0;
-    if (!r->recovery.du || !r->recovery.before || !r->recovery.checked)
+    if (!r->recovery.du || !r->recovery.before || !r->recovery.checked || !r->recovery.held)
         return tk_error_set(err, TK_ENOMEM, "out of memory for a run of %zu vertices", vertices);
     return TK_OK;
 }

@@ -107,6 +107,7 @@ struct tk_run {
         int tiny_steps;
         double seconds;
         long length_steps; /* judged by their length (take_step) */
+        long corrected_steps; /* judged after their correction (take_step) */
     } stepping;
 
     struct {             /* recovery.c */
@@ -116,6 +117,8 @@ struct tk_run {
         double *du;      /* 3V: a Newton step */
         double *before;  /* 3V: the curve before this step, to undo it */
         double *checked; /* 3V: the curve last checked, and what it gave */
+        double *held;    /* 3V: the run's curve while a step's trial is
+                            corrected (stepping.c) */
         size_t checked_vertices; /* 0: none */
         double checked_worst;
         double seconds, nnls_seconds, check_seconds;
@@ -136,7 +139,9 @@ struct tk_run {
                                     (0: not yet) */
         int coarse_level;    /* halvings of the vertex count still to undo */
         int coarse_levels;   /* of them at the start (with the vertices
-                                option, at the final reference once fixed) */
+                                option, once a loose start's ropelength
+                                allows them, and at the final reference
+                                once fixed) */
         bool move_on;        /* refine before the next step */
         size_t resampled_from; /* history entries before the last resampling */
         double share_from;   /* budget spent when the current schedule began

@@ -396,9 +396,12 @@ static int step(tk_run *r, tk_error *err)
         double worst = 0.0;
         if (!rc)
             rc = tk_recovery_violation(r, c, &worst, err);
-        if (!rc && worst > 0.5 * tk_tolerance_overstep(r))
-            rc = tk_recovery_correct(r, TK_CORRECTIONS, TK_RESCALE_FEASIBILITY,
-                                     &rep.corrections, err);
+        if (!rc && worst > 0.5 * tk_tolerance_overstep(r)) {
+            int corrections = 0;
+            rc = tk_recovery_correct(r, TK_CORRECTIONS, TK_RESCALE_FEASIBILITY, &corrections,
+                                     err);
+            rep.corrections += corrections;
+        }
         if (rc != TK_ENUMERIC || !(rep.step_size > 0.0))
             break;
         /* Newton steps could not restore the thickness: undo the step,
@@ -524,6 +527,7 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out)
         .rescales = r->recovery.rescales,
         .bent_corrections = r->recovery.bent,
         .length_steps = r->stepping.length_steps,
+        .corrected_steps = r->stepping.corrected_steps,
         .largest_rescale = r->recovery.largest_rescale,
     };
 }

@@ -59,6 +59,7 @@ START_TEST(tables_describe_their_structs)
     ck_assert(t.largest_rescale == 3.0);
     ck_assert_int_eq(t.bent_corrections, 4);
     ck_assert_int_eq(t.length_steps, 5);
+    ck_assert_int_eq(t.corrected_steps, 6);
     ck_assert(t.search == 0.0 && t.total == 0.0 && t.factorisations == 0);
 }
 END_TEST

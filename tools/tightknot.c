@@ -237,8 +237,9 @@ static const char tighten_help_end[] =
     "                          the coarsest polygon alone, before the first\n"
     "                          refinement), and recovery: {undone_steps,\n"
     "                          rescales, largest_rescale, bent_corrections,\n"
-    "                          length_steps}, error recovery's last resorts\n"
-    "                          and the steps judged by their length alone\n"
+    "                          length_steps, corrected_steps}, error\n"
+    "                          recovery's last resorts and the steps judged\n"
+    "                          by their length alone or after their correction\n"
     "  -h, --help              show this help\n"
     "\n"
     "A progress line goes to standard error when it is a terminal.  The\n"
@@ -922,6 +923,10 @@ static int cmd_tighten(int argc, char **argv)
             printf("  step control: %ld step%s judged by the length alone (along the motion the "
                    "length over the thickness rose at first order)\n",
                    t.length_steps, t.length_steps == 1 ? "" : "s");
+        if (t.corrected_steps > 0)
+            printf("  step control: %ld step%s judged after their correction (along curved "
+                   "constraints)\n",
+                   t.corrected_steps, t.corrected_steps == 1 ? "" : "s");
         size_t ne = 0;
         const tk_escape *e = tk_run_escapes(run, &ne);
         for (size_t k = 0; k < ne; k++) {

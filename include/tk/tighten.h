@@ -273,7 +273,11 @@ const tk_invariants *tk_run_type_latest(const tk_run *r);
     X(length_steps, LONG, 0, 0, 9e15, "length_steps",                                        \
       "steps judged by their length alone: the length over the thickness their violation "   \
       "leaves rose at first order in the step size (section 4.5; the NNLS answer is not "    \
-      "exact enough for the stiff kinks of a fine polygon)")
+      "exact enough for the stiff kinks of a fine polygon)")                                 \
+    X(corrected_steps, LONG, 0, 0, 9e15, "corrected_steps",                                  \
+      "steps judged after their correction: along curved constraints the length over the "   \
+      "thickness their violation leaves rose, and fell once the violation was corrected "    \
+      "(section 4.6)")
 
 /* Where a run's wall time went, in seconds.  The first four are the
  * operations every step repeats, wherever in the flow they happen;
