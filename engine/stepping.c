@@ -88,6 +88,13 @@ static double merit(double length, double worst)
  * polish at the fourth level (bench/steps --curve) lowered it by 1e-8
  * against 5.4e-5, their steps 1e-3 against 1e-2 to 3e-2. */
 #define CORRECTED_NEWTON 3
+/* Not where the resolved motion is below this fraction of the length
+ * gradient (the step's residual): the curve is critical but for
+ * rounding, and its steps are of rounding's direction.  The catalogue's
+ * unlink 0.2.1 (two round circles, residual 2e-15 from step 32) took
+ * steps of 1e9 there, each corrected and judged some 1e-8 lower, and
+ * never stalled. */
+#define CORRECTED_CRITICAL 1e-9
 
 /* The run's curve becomes the trial (r->shared.trial, the curve plus h
  * times the motion), corrected; *taken when that lowers the merit below
@@ -215,7 +222,8 @@ static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *al
             last_h = last_rise = 0.0;
             continue;
         }
-        if (!corrected && worst > tk_tolerance_correction(r)) {
+        if (!corrected && worst > tk_tolerance_correction(r) &&
+            rep->residual > CORRECTED_CRITICAL) {
             corrected = true;
             rc = judge_corrected(r, rep, h, merit_before, &corrected_ok, err);
             if (rc || corrected_ok)

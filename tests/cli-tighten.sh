@@ -73,7 +73,8 @@ grep -q "^  recovery: 0 steps undone and taken shorter, 0 rescales of the whole 
 check $? "the summary's recovery line: $(grep recovery "$tmp/summary.txt")"
 
 # --json reports the counts the summary does, by the same names as
-# TK_RECOVERY_FIELDS: 1,000 steps of this start judge one by its length
+# TK_RECOVERY_FIELDS: 1,000 steps of this start judge some step by its
+# length or after its correction
 "$tk" tighten "$tmp/trefoil.vect" --autoscale --steps 1000 >"$tmp/long.txt" 2>"$tmp/err"
 check $? "tighten (text, 1,000 steps) exits 0: $(cat "$tmp/err")"
 "$tk" tighten "$tmp/trefoil.vect" --autoscale --steps 1000 --json >"$tmp/long.json" 2>"$tmp/err"
@@ -81,8 +82,15 @@ check $? "tighten --json (1,000 steps) exits 0: $(cat "$tmp/err")"
 judged=$(sed -n 's/^  step control: \([0-9]*\) steps* judged by the length alone.*/\1/p' \
     "$tmp/long.txt")
 given=$(value length_steps "$tmp/long.json")
-[ -n "$judged" ] && [ "$judged" -gt 0 ] && [ "$given" = "$judged" ]
+[ "$given" = "${judged:-0}" ]
 check $? "--json's length_steps $given is the summary's ${judged:-none}"
+corrected=$(sed -n 's/^  step control: \([0-9]*\) steps* judged after their correction.*/\1/p' \
+    "$tmp/long.txt")
+given_corrected=$(value corrected_steps "$tmp/long.json")
+[ "$given_corrected" = "${corrected:-0}" ]
+check $? "--json's corrected_steps $given_corrected is the summary's ${corrected:-none}"
+[ $((${judged:-0} + ${corrected:-0})) -gt 0 ]
+check $? "1,000 steps judge some step by its length or after its correction"
 said=$(sed -n 's/^  recovery: \([0-9]*\) steps undone and taken shorter, \([0-9]*\) rescales.*/\1 \2/p' \
     "$tmp/long.txt")
 given="$(value undone_steps "$tmp/long.json") $(value rescales "$tmp/long.json")"
