@@ -120,59 +120,98 @@ done
 # The service's suite runs a second time against the address sanitizer
 # build's daemon and command line, and a third against the thread
 # sanitizer's.
+#
+# They run in two lanes too, the longest first, each suite in its own
+# temporary directories, on its own free ports and (on PostgreSQL) in
+# databases named by process, so two never share anything.
+run_suite() {
+    t=$1
+    log=$2
+    dir=$build
+    store=sqlite
+    # every file but those of the PostgreSQL pass alone
+    only=$(ls tests/service/*.test.mjs | grep -v -e cluster | tr '\n' ' ')
+    case "$t" in
+    pg:*)
+        t=${t#pg:}; store=postgresql
+        only=$(ls tests/service/*.test.mjs | grep -e cluster -e queue -e restart -e results \
+            -e tokens -e workers | tr '\n' ' ')
+        ;;
+    asan:*)
+        # all but chaos: its kill -9 paths (the store reopened, the
+        # jobs requeued and resumed) run here in restart.test.mjs,
+        # and chaos repeats them ten times
+        dir=$asan; t=${t#asan:}
+        only=$(ls tests/service/*.test.mjs | grep -v -e chaos -e cluster | tr '\n' ' ')
+        ;;
+    tsan:*)
+        dir=$tsan; t=${t#tsan:}
+        only=$(ls tests/service/*.test.mjs | grep -v -e chaos -e store -e cluster | tr '\n' ' ')
+        ;;
+    esac
+    [ -f "$t" ] || return
+    t0=$(date +%s)
+    TK_BUILD=$dir TK_ASAN_BUILD=$asan TK_DAEMON=$dir/tightknotd TK_CLI=$dir/tightknot \
+        TK_WEB=$dir/web TK_SERVICE_TESTS=$only TK_STORE=$store sh "$t" >"$log" 2>&1
+    line=$(grep -E '^[a-z-]+: [0-9]+ passed, [0-9]+ failed' "$log" | tail -n 1)
+    if [ -z "$line" ]; then
+        echo "FAIL $t: no summary"; tail -n 20 "$log"
+        echo "counts: 0 1 0"
+        return
+    fi
+    p=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\1/')
+    f=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\2/')
+    k=$(echo "$line" | sed -nE 's/.* ([0-9]+) skipped.*/\1/p')
+    echo "$t ($dir, $store): $line ($(($(date +%s) - t0)) s)"
+    grep -E '^SKIP ' "$log"
+    [ "$f" -eq 0 ] || grep -E '^FAIL|^not ok|^# fail|Error' "$log" | head -n 40
+    # a ThreadSanitizer report: where the two accesses were
+    [ "$f" -eq 0 ] || grep -E '^  (Write|Read|Previous|Atomic|Location|Thread T)|^    #[0-9] ' "$log" |
+        head -n 60
+    echo "counts: $p $f ${k:-0}"
+}
+
+suite_lane() {
+    i=0
+    for t in $suites; do
+        i=$((i + 1))
+        mkdir "$lanes/suite.$i" 2>/dev/null || continue
+        run_suite "$t" "$lanes/suite.log.$i" >"$lanes/suite.out.$i"
+    done
+}
+
 if [ "$unit_only" -eq 0 ]; then
-    suites="tests/cli-*.sh tests/*/run.sh"
+    tsan=build/tsan
+    # the longest first: the service's suite, in each build and store
+    suites="tests/service/run.sh"
+    [ -n "$asan" ] && [ -x "$asan/tightknotd" ] && suites="$suites asan:tests/service/run.sh"
+    suites="$suites tests/web/run.sh"
+    # against the thread sanitizer's daemon, every file but the two
+    # slowest (kill -9 ten times, a file system filling up: no thread
+    # interplay the others lack)
+    [ -x "$tsan/tightknotd" ] && suites="$suites tsan:tests/service/run.sh"
     # the service's suite once more with every daemon's store on
     # PostgreSQL: the files whose jobs are stored, restarted and shared
     # (the others poke the SQLite file or never store a job)
     [ -n "$TK_PG_URL" ] && suites="$suites pg:tests/service/run.sh"
-    [ -n "$asan" ] && [ -x "$asan/tightknotd" ] && suites="$suites asan:tests/service/run.sh"
-    # and against the thread sanitizer's daemon, every file but the two
-    # slowest (kill -9 ten times, a file system filling up: no thread
-    # interplay the others lack)
-    tsan=build/tsan
-    [ -x "$tsan/tightknotd" ] && suites="$suites tsan:tests/service/run.sh"
+    for t in tests/cli-*.sh tests/*/run.sh; do
+        case " $suites " in *" $t "*) ;; *) suites="$suites $t" ;; esac
+    done
+    suite_lane &
+    suite_lane &
+    wait
+    i=0
     for t in $suites; do
-        dir=$build
-        store=sqlite
-        # every file but those of the PostgreSQL pass alone
-        only=$(ls tests/service/*.test.mjs | grep -v -e cluster | tr '\n' ' ')
-        case "$t" in
-        pg:*)
-            t=${t#pg:}; store=postgresql
-            only=$(ls tests/service/*.test.mjs | grep -e cluster -e queue -e restart -e results \
-                -e tokens -e workers | tr '\n' ' ')
-            ;;
-        asan:*)
-            # all but chaos: its kill -9 paths (the store reopened, the
-            # jobs requeued and resumed) run here in restart.test.mjs,
-            # and chaos repeats them ten times
-            dir=$asan; t=${t#asan:}
-            only=$(ls tests/service/*.test.mjs | grep -v -e chaos -e cluster | tr '\n' ' ')
-            ;;
-        tsan:*)
-            dir=$tsan; t=${t#tsan:}
-            only=$(ls tests/service/*.test.mjs | grep -v -e chaos -e store -e cluster | tr '\n' ' ')
-            ;;
-        esac
-        [ -f "$t" ] || continue
-        t0=$(date +%s)
-        TK_BUILD=$dir TK_ASAN_BUILD=$asan TK_DAEMON=$dir/tightknotd TK_CLI=$dir/tightknot \
-            TK_WEB=$dir/web TK_SERVICE_TESTS=$only TK_STORE=$store sh "$t" >"$log" 2>&1
-        line=$(grep -E '^[a-z-]+: [0-9]+ passed, [0-9]+ failed' "$log" | tail -n 1)
-        if [ -z "$line" ]; then
-            failed=$((failed + 1)); echo "FAIL $t: no summary"; tail -n 20 "$log"; continue
+        i=$((i + 1))
+        out="$lanes/suite.out.$i"
+        counts=$(grep '^counts: ' "$out" 2>/dev/null | tail -n 1)
+        if [ -z "$counts" ]; then
+            failed=$((failed + 1)); echo "FAIL $t: no totals"; continue
         fi
-        p=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\1/')
-        f=$(echo "$line" | sed -E 's/.*: ([0-9]+) passed, ([0-9]+) failed.*/\2/')
-        k=$(echo "$line" | sed -nE 's/.* ([0-9]+) skipped.*/\1/p')
-        passed=$((passed + p)); failed=$((failed + f)); skipped=$((skipped + ${k:-0}))
-        echo "$t ($dir, $store): $line ($(($(date +%s) - t0)) s)"
-        grep -E '^SKIP ' "$log"
-        [ "$f" -eq 0 ] || grep -E '^FAIL|^not ok|^# fail|Error' "$log" | head -n 40
-        # a ThreadSanitizer report: where the two accesses were
-        [ "$f" -eq 0 ] || grep -E '^  (Write|Read|Previous|Atomic|Location|Thread T)|^    #[0-9] ' "$log" |
-            head -n 60
+        grep -v '^counts: ' "$out"
+        passed=$((passed + $(echo "$counts" | cut -d ' ' -f 2)))
+        failed=$((failed + $(echo "$counts" | cut -d ' ' -f 3)))
+        skipped=$((skipped + $(echo "$counts" | cut -d ' ' -f 4)))
     done
 fi
 

@@ -146,7 +146,7 @@ START_TEST(a_symmetric_figure_eight_escapes_to_the_tight_one)
         return;
     static const start fig8 = {"fig8", FIGURE_EIGHT, NULL, 0, 0, 200, 0, 0};
     double trapped;
-    tighten_start("4_1", &fig8, 280, 25000, 42.09703, 0.002, &trapped);
+    tighten_start("4_1", &fig8, 280, 15000, 42.09703, 0.002, &trapped);
     ck_assert_msg(trapped > 1.1 * 42.09703, "the first tightening ended at %.6f", trapped);
 }
 END_TEST
