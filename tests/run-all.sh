@@ -35,36 +35,70 @@ case $? in
 esac
 export TK_PG_URL
 
-# Check's summary line: "100%: Checks: 7, Failures: 0, Errors: 0"
-count_check() {
-    line=$(grep -E '^[0-9]+%: Checks: ' "$log" | tail -n 1)
+# One unit test program, $1, its output to $2: its line (and any failure
+# or skip), then "counts: PASSED FAILED SKIPPED".  Check's summary line:
+# "100%: Checks: 7, Failures: 0, Errors: 0".
+run_unit() {
+    quick=1
+    case "$1" in "$build"/tests/*) quick=0 ;; esac
+    t0=$(date +%s)
+    TK_QUICK=$quick "$1" >"$2" 2>&1
+    line=$(grep -E '^[0-9]+%: Checks: ' "$2" | tail -n 1)
     if [ -z "$line" ]; then
-        failed=$((failed + 1))
         echo "FAIL $1: no summary (crashed?)"
-        tail -n 20 "$log"
+        tail -n 20 "$2"
+        echo "counts: 0 1 0"
         return
     fi
     checks=$(echo "$line" | sed -E 's/.*Checks: ([0-9]+).*/\1/')
     bad=$(echo "$line" | sed -E 's/.*Failures: ([0-9]+), Errors: ([0-9]+).*/\1 \2/' | awk '{print $1 + $2}')
     # a test that skipped says so (tkt_skip); Check counted it as passed
-    skips=$(grep -c '^SKIP ' "$log")
-    passed=$((passed + checks - bad - skips))
-    failed=$((failed + bad))
-    skipped=$((skipped + skips))
+    skips=$(grep -c '^SKIP ' "$2")
     echo "$1: $line, $skips skipped ($(($(date +%s) - t0)) s)"
-    grep -E '^SKIP ' "$log"
-    [ "$bad" -eq 0 ] || grep -E ':[EF]:' "$log"
+    grep -E '^SKIP ' "$2"
+    [ "$bad" -eq 0 ] || grep -E ':[EF]:' "$2"
+    echo "counts: $((checks - bad - skips)) $bad $skips"
+}
+
+# Runs $2 (run_unit or run_suite) on each of the list $1 in two lanes, one
+# a core: each lane takes the next not yet taken (mkdir is the lock), so
+# a list ordered longest first has its lanes end together.  Each one's
+# output goes to a file of its own; they are printed in the list's order
+# at the end and their counts added to the totals.
+in_lanes() {
+    mkdir "$lanes/$2"
+    for _ in 1 2; do
+        (
+            i=0
+            for t in $1; do
+                i=$((i + 1))
+                mkdir "$lanes/$2/taken.$i" 2>/dev/null || continue
+                $2 "$t" "$lanes/$2/log.$i" >"$lanes/$2/out.$i"
+            done
+        ) &
+    done
+    wait
+    i=0
+    for t in $1; do
+        i=$((i + 1))
+        out="$lanes/$2/out.$i"
+        counts=$(grep '^counts: ' "$out" 2>/dev/null | tail -n 1)
+        if [ -z "$counts" ]; then
+            failed=$((failed + 1)); echo "FAIL $t: no totals"; continue
+        fi
+        grep -v '^counts: ' "$out"
+        passed=$((passed + $(echo "$counts" | cut -d ' ' -f 2)))
+        failed=$((failed + $(echo "$counts" | cut -d ' ' -f 3)))
+        skipped=$((skipped + $(echo "$counts" | cut -d ' ' -f 4)))
+    done
 }
 
 # The sanitizer build runs every test, but the long tightening runs in
 # their short form (TK_QUICK): they are the same code paths, ten times
 # slower under the sanitizers.
-#
-# The unit test programs of both builds run in two lanes, one a core
-# (none of them times itself, and their PostgreSQL databases are named by
-# process).  Each lane takes the next program not yet taken (mkdir is the
-# lock), the longest first so that the lanes end together; each program's
-# line and totals go to a file of its own, printed in order at the end.
+# The unit test programs of both builds run in two lanes (none of them
+# times itself, and their PostgreSQL databases are named by process), the
+# longest first.
 units=""
 for dir in "$build" $asan; do
     [ -d "$dir/tests" ] || continue
@@ -78,40 +112,7 @@ units=$(printf '%s\n' $units)
 units="$(for name in starts tighten struts nnls history; do echo "$units" | grep -E "/test_$name\$"; done)
 $(echo "$units" | grep -vE "$long")"
 
-unit_lane() {
-    i=0
-    for t in $units; do
-        i=$((i + 1))
-        mkdir "$lanes/taken.$i" 2>/dev/null || continue
-        quick=1
-        case "$t" in "$build"/tests/*) quick=0 ;; esac
-        log="$lanes/log.$i"
-        passed=0
-        failed=0
-        skipped=0
-        t0=$(date +%s)
-        TK_QUICK=$quick "$t" >"$log" 2>&1
-        count_check "$t" >"$lanes/out.$i"
-        echo "counts: $passed $failed $skipped" >>"$lanes/out.$i"
-    done
-}
-unit_lane &
-unit_lane &
-wait
-i=0
-# shellcheck disable=SC2031 # the totals here are this shell's own
-for t in $units; do
-    i=$((i + 1))
-    out="$lanes/out.$i"
-    counts=$(grep '^counts: ' "$out" 2>/dev/null | tail -n 1)
-    if [ -z "$counts" ]; then
-        failed=$((failed + 1)); echo "FAIL $t: no totals"; continue
-    fi
-    grep -v '^counts: ' "$out"
-    passed=$((passed + $(echo "$counts" | cut -d ' ' -f 2)))
-    failed=$((failed + $(echo "$counts" | cut -d ' ' -f 3)))
-    skipped=$((skipped + $(echo "$counts" | cut -d ' ' -f 4)))
-done
+in_lanes "$units" run_unit
 
 # The command-line tests (tests/cli-*.sh) and the suites in directories
 # (tests/*/run.sh: the service's API, the page in a browser, the fuzz
@@ -171,15 +172,6 @@ run_suite() {
     echo "counts: $p $f ${k:-0}"
 }
 
-suite_lane() {
-    i=0
-    for t in $suites; do
-        i=$((i + 1))
-        mkdir "$lanes/suite.$i" 2>/dev/null || continue
-        run_suite "$t" "$lanes/suite.log.$i" >"$lanes/suite.out.$i"
-    done
-}
-
 if [ "$unit_only" -eq 0 ]; then
     tsan=build/tsan
     # the longest first: the service's suite, in each build and store
@@ -197,22 +189,7 @@ if [ "$unit_only" -eq 0 ]; then
     for t in tests/cli-*.sh tests/*/run.sh; do
         case " $suites " in *" $t "*) ;; *) suites="$suites $t" ;; esac
     done
-    suite_lane &
-    suite_lane &
-    wait
-    i=0
-    for t in $suites; do
-        i=$((i + 1))
-        out="$lanes/suite.out.$i"
-        counts=$(grep '^counts: ' "$out" 2>/dev/null | tail -n 1)
-        if [ -z "$counts" ]; then
-            failed=$((failed + 1)); echo "FAIL $t: no totals"; continue
-        fi
-        grep -v '^counts: ' "$out"
-        passed=$((passed + $(echo "$counts" | cut -d ' ' -f 2)))
-        failed=$((failed + $(echo "$counts" | cut -d ' ' -f 3)))
-        skipped=$((skipped + $(echo "$counts" | cut -d ' ' -f 4)))
-    done
+    in_lanes "$suites" run_suite
 fi
 
 echo "tests: $passed passed, $failed failed, $skipped skipped"
