@@ -150,7 +150,7 @@ run_suite() {
         only=$(ls tests/service/*.test.mjs | grep -v -e chaos -e store -e cluster | tr '\n' ' ')
         ;;
     esac
-    [ -f "$t" ] || return
+    if [ ! -f "$t" ]; then echo "counts: 0 0 0"; return; fi
     t0=$(date +%s)
     TK_BUILD=$dir TK_ASAN_BUILD=$asan TK_DAEMON=$dir/tightknotd TK_CLI=$dir/tightknot \
         TK_WEB=$dir/web TK_SERVICE_TESTS=$only TK_STORE=$store sh "$t" >"$log" 2>&1

@@ -18,7 +18,8 @@
  *      mid-step included, found again with the tree) is within the
  *      overstep tolerance (section 4.5) and the length over the
  *      thickness it leaves is lower (the first trial that fails only the
- *      latter is judged again after its correction);
+ *      latter is judged again after its correction, on the final
+ *      polygon);
  *   5. error recovery: while some constraint is violated beyond the
  *      correction tolerance, Newton steps with the damped minimum-norm
  *      solution of A^T du = -R (section 4.6), damped as much as they need;
