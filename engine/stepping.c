@@ -96,16 +96,26 @@ static double merit(double length, double worst)
  * steps of 1e9 there, each corrected and judged some 1e-8 lower, and
  * never stalled. */
 #define CORRECTED_CRITICAL 1e-9
-/* Nor on a coarser polygon than the final one: its looser tolerances let
- * the halved trials go about as far, at a fraction of a Newton step each,
- * and its plateaus are for finding a basin rather than polishing.  The
- * catalogue's 5.1 at resolution 5 (120 s) took 2.5 ms a step on its
- * first coarse polygon (135 vertices) and 2,303 steps to its plateau with
- * corrected trials there, 1.9 ms and 2,369 steps without; it came within
- * 0.5% of the atlas's 5_1 after 11.9 s against 8.1 s, and both ended at
- * 47.2418.  L(3,2,5) at 480 vertices, 600 s, ends at 56.71727 with
- * corrected trials on its final polygon alone (56.71706 on every
- * polygon; the atlas's 6_1, 56.71771). */
+
+/* Whether a trial that shortens the curve but raises the merit, leaving
+ * the violation `worst`, is worth judging after its correction: it must
+ * violate something the correction would mend, the curve must not be
+ * critical (CORRECTED_CRITICAL), and the polygon must be the final one.
+ * A coarser polygon's looser tolerances let the halved trials go about as
+ * far, at a fraction of a Newton step each, and its plateaus are for
+ * finding a basin rather than polishing: the catalogue's 5.1 at
+ * resolution 5 (120 s) took 2.5 ms a step on its first coarse polygon
+ * (135 vertices) and 2,303 steps to its plateau with corrected trials
+ * there, 1.9 ms and 2,369 steps without; it came within 0.5% of the
+ * atlas's 5_1 after 11.9 s against 8.1 s, and both ended at 47.2418.
+ * L(3,2,5) at 480 vertices, 600 s, ends at 56.71727 with corrected
+ * trials on its final polygon alone (56.71706 on every polygon; the
+ * atlas's 6_1, 56.71771). */
+static bool correction_pays(const tk_run *r, const tk_step_report *rep, double worst)
+{
+    return worst > tk_tolerance_correction(r) && rep->residual > CORRECTED_CRITICAL &&
+           tk_schedule_final(r);
+}
 
 /* The run's curve becomes the trial (r->shared.trial, the curve plus h
  * times the motion), corrected; *taken when that lowers the merit below
@@ -233,8 +243,7 @@ static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *al
             last_h = last_rise = 0.0;
             continue;
         }
-        if (!corrected && worst > tk_tolerance_correction(r) &&
-            rep->residual > CORRECTED_CRITICAL && tk_schedule_final(r)) {
+        if (!corrected && correction_pays(r, rep, worst)) {
             corrected = true;
             rc = judge_corrected(r, rep, h, merit_before, &corrected_ok, err);
             if (rc || corrected_ok)
