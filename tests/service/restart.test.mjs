@@ -101,15 +101,19 @@ describe('kill -9 and restart on the same store', () => {
             await assertResumedFrames(d2, done);
             // the schedule went on where it was: the job ends on its final
             // polygon, reckoned from the ropelength of the step before it
-            // first got there (below the start's, whose count is the most
-            // it may have)
+            // first got there, or from the start's where that was higher
+            // (a worker starved by a loaded machine leaves its coarse
+            // levels on their share of the time, before their plateau:
+            // 3.1 at step 251, ropelength 37.30, start 36.19)
             const h = (await d2.get(`/v1/jobs/${a.id}/history`)).json.steps;
             const most = Math.max(...h.map((s) => s.vertices));
             const up = h.findIndex((s, i) => i > 0 && s.vertices === most && h[i - 1].vertices < most);
             assert.ok(up > 0, 'the job refined');
             assert.equal(h[up].step, h[up - 1].step + 1, 'the history holds the step before the refinement');
-            assert.equal(done.vertices, Math.ceil(10 * h[up - 1].ropelength), 'the final level');
-            assert.ok(done.vertices < (await finest).summary.vertices, 'fewer than the start\'s count');
+            const start = (await finest).summary.vertices;
+            assert.equal(done.vertices, Math.min(Math.ceil(10 * h[up - 1].ropelength), start),
+                `the final level: refined at step ${h[up].step} from ropelength ` +
+                `${h[up - 1].ropelength} (${h[up - 1].vertices} vertices); the start's count ${start}`);
 
             // the two that never started run from their input, as the CLI does
             const want = (await cli).summary;
