@@ -96,6 +96,29 @@ bool tk_escape_converged(const tk_run *r)
                ESCAPE_CRAWL;
 }
 
+/* The coarsest level, where tries are judged (judge_coarse, explore), is
+ * polished before it is left, as the final polygon is: at its first stall
+ * a plateau still falls, slowly, and where it has fallen to ranks the
+ * final figure better than where it stalled.  T(3,4) at 489 vertices
+ * (600 s) settled on curves whose 245-vertex polygons stalled between
+ * 61.100 and 61.12 and its runs ended above the atlas's 60.99699 in three
+ * seeds of four (61.00998, median 61.00838); the same start tightened on
+ * 245 vertices alone for 150 s (polished, with escapes) reached 61.0535
+ * and 61.0815 for seeds 1 and 2, and refined from there to 489 for 450 s
+ * without escapes 60.99448 and 61.02733.  Polished at its coarsest level,
+ * three seeds of four end below the atlas (60.99433 for seed 1, median
+ * 60.99468).  Not the first tightening's level, before any try: the
+ * disguised figure-eight of an_explored_try_leaves_a_coarse_trap, whose
+ * first stall (55.30, kinks at the curvature bound) is where exploring
+ * leaves for the tight knot's basin, crawled down from there under the
+ * smaller tolerances for the level's whole share of 16,000 steps, to
+ * 50.69 with a residual of 0.13, and explored nothing. */
+bool tk_escape_judged_here(const tk_run *r)
+{
+    return tk_escape_tries(r) > 0 && !r->escape.polishing && r->schedule.coarse_level > 0 &&
+           r->schedule.coarse_level == r->schedule.coarse_levels;
+}
+
 /* *kept becomes a copy of c, in place when it has c's shape; NULL when
  * that fails. */
 static int keep(tk_curve **kept, const tk_curve *c, tk_error *err)

@@ -355,6 +355,11 @@ void tk_recovery_free(tk_run *r);
  * than a set fraction over a window of steps, or by less than a larger
  * one for a set share of the budget (a crawl). */
 bool tk_escape_converged(const tk_run *r);
+/* Whether the run's polygon is where its tries are judged (the coarsest
+ * level of a try, explored or not, or of a curve put back after one; not
+ * the best's polishing): polished there before it is left, as a final
+ * polygon is. */
+bool tk_escape_judged_here(const tk_run *r);
 /* After each step's figures, with escapes: the curve on the final polygon
  * is kept if it is the best so far, and the try under way's lowest noted. */
 void tk_escape_after_step(tk_run *r);

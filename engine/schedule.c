@@ -781,13 +781,21 @@ static bool stalled(const tk_run *r)
 }
 
 /* Judged on the history before this step's figures, after its motion and
- * before its error recovery (which then works to the new tolerances). */
+ * before its error recovery (which then works to the new tolerances).  A
+ * coarse level moves on at its first stall, unless escapes judge their
+ * tries there: then it is polished first, as the final polygon is, and
+ * moves on when its last level stalls. */
 void tk_schedule_watch(tk_run *r)
 {
-    if (r->schedule.polish_level < polish_levels(r) &&
-        (stalled(r) || critical_since(r, r->schedule.polish_from)) &&
-        !tk_schedule_move_on(r)) {
-        r->schedule.polish_level++;
-        r->schedule.polish_from = r->life.nhistory;
+    bool coarse = r->schedule.coarse_level > 0;
+    bool deeper = (!coarse || tk_escape_judged_here(r)) &&
+                  r->schedule.polish_level < polish_levels(r);
+    if (!(deeper || coarse) || !(stalled(r) || critical_since(r, r->schedule.polish_from)))
+        return;
+    if (!deeper) {
+        tk_schedule_move_on(r);
+        return;
     }
+    r->schedule.polish_level++;
+    r->schedule.polish_from = r->life.nhistory;
 }

@@ -1607,7 +1607,9 @@ START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
     o.autoscale = true;
     o.resolution = 5;
     o.escapes = 2;
-    o.max_steps = 9000; /* the second escape (after an explored one) starts before the last fifth */
+    /* the second escape (after an explored one) starts before the last
+     * fifth: at step 10,215, the tries polished on their coarse polygons */
+    o.max_steps = 14000;
     tk_run *run = NULL;
     tk_error err;
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
@@ -1692,9 +1694,9 @@ START_TEST(a_loose_start_at_a_vertex_count_escapes_coarse)
     o.autoscale = true;
     o.vertices = (size_t)floor(4.8 * reckoned);
     o.escapes = 2;
-    /* two escapes after the first refinement come by step 2,600; the
-     * resumed run takes the rest */
-    o.max_steps = 5000;
+    /* two escapes after the first refinement come within it (their
+     * coarse polygons polished); the resumed run takes the rest */
+    o.max_steps = 8000;
     tk_run *run = NULL;
     tk_error err;
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
@@ -1869,6 +1871,87 @@ START_TEST(a_fine_coarse_level_waits_as_many_more_steps)
     }
     ck_assert_uint_eq(levels, 2);
     ck_assert_double_ge(most, 1.5); /* the rule in steps alone would differ */
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
+/* The coarse level of report `from`'s polygon, checked against the rule
+ * above: it moves on at its first stall, or, polished, each stall (its
+ * bound a third smaller at each level) or 20 steps in a row with a
+ * residual below 1e-3 take it a level down, and the stall of the fourth
+ * level moves it on (a coarse polygon keeps all four: 0.3 h^2 is above
+ * the options' 3e-4).  A level that begins at step i's watch starts its
+ * window at report i; a move-on shows as report i + 1's count or
+ * restarts.  The report where it moved on, or 0 if it did not. */
+static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t from, bool polished,
+                                   size_t *first_stall)
+{
+    int level = 0;
+    *first_stall = 0;
+    for (size_t i = from + 1; i + 1 < nh; i++) {
+        double edge = h[i - 1].ropelength / (2.0 * (double)h[i].vertices);
+        size_t window = edge >= 0.1 ? 200 : (size_t)lround(200.0 * 0.1 / edge);
+        bool critical = polished && i >= from + 20;
+        for (size_t k = i >= 20 ? i - 20 : 0; k < i && critical; k++)
+            critical = h[k].residual < 1e-3;
+        bool stall = fall_over(h, from, i, window) < 1e-4 * pow(1.0 / 3.0, level) || critical;
+        bool moved = h[i + 1].vertices != h[i].vertices || h[i + 1].restarts != h[i].restarts;
+        ck_assert_msg(moved == (stall && level == (polished ? 4 : 0)),
+                      "step %ld at level %d (since report %zu): %s, %s", h[i].step, level, from,
+                      stall ? "stalled" : "going on", moved ? "moved on" : "stayed");
+        if (moved)
+            return i;
+        if (stall) {
+            *first_stall = *first_stall ? *first_stall : i;
+            level++;
+            from = i;
+        }
+    }
+    return 0;
+}
+
+/* With escapes, the coarsest level is where the tries are judged
+ * (escape.c), so a try's is polished before it is left; the first
+ * tightening's moves on at its first stall, as without escapes, to the
+ * first explored try.  The same trefoil as above. */
+START_TEST(the_coarsest_level_of_a_try_is_polished_first)
+{
+    if (quick() && tkt_skip("the_coarsest_level_of_a_try_is_polished_first", LONG_RUN))
+        return;
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 200, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.vertices = 600;
+    o.escapes = 1;
+    o.max_steps = 1000000;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, 150);
+    size_t nh = 0;
+    const tk_step_report *h = tk_run_history(run, &nh);
+    /* until the explored try has left its coarse polygon */
+    while (h[nh - 1].vertices == 150 && h[nh - 1].restarts <= h[0].restarts + 1 &&
+           h[nh - 1].step < 20000) {
+        ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
+        h = tk_run_history(run, &nh);
+    }
+    size_t stall = 0;
+    size_t first = coarse_level_checked(h, nh, 0, false, &stall);
+    ck_assert_uint_gt(first, 0);
+    size_t ne = 0;
+    const tk_escape *e = tk_run_escapes(run, &ne);
+    ck_assert(ne == 1 && e[0].explored && h[first + 1].escapes == 1);
+    size_t tried = coarse_level_checked(h, nh, first + 1, true, &stall);
+    ck_assert_uint_gt(tried, 0);
+    ck_assert(e[0].coarse == h[tried].ropelength);
+    printf("T(2,3) at 600, escapes: the first tightening left its 150-vertex level at step %ld "
+           "(%.5f); the explored try's level first stalled at step %ld (%.5f) and moved on "
+           "polished at step %ld (%.5f)\n",
+           h[first].step, h[first].ropelength, h[stall].step, h[stall].ropelength,
+           h[tried].step, h[tried].ropelength);
     tk_run_free(&run);
     tk_curve_free(&c);
 }
@@ -2188,7 +2271,10 @@ START_TEST(a_try_behind_on_its_coarsest_polygon_is_given_up_there)
     o.vertices = 200;
     o.escapes = 8;
     o.seed = 3; /* seed 1's tries are all behind the lowest explored curve */
-    o.max_steps = 12000;
+    /* polished on its coarse polygon, every try ends in the lineage's
+     * basin, its figure within 3e-5 of the lineage's: seed 3's sixth is
+     * the first a hair below it */
+    o.max_steps = 30000;
     tk_run *run = NULL;
     tk_error err;
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
@@ -2357,6 +2443,7 @@ int main(void)
     tcase_add_test(tc, a_loose_coarse_level_follows_the_ropelength);
     tcase_add_test(tc, a_loose_start_at_a_vertex_count_escapes_coarse);
     tcase_add_test(tc, a_fine_coarse_level_waits_as_many_more_steps);
+    tcase_add_test(tc, the_coarsest_level_of_a_try_is_polished_first);
     tcase_add_test(tc, unknot_and_unlink_are_handled);
     tcase_add_test(tc, hopf_link_tightens_towards_8_pi);
     tcase_add_test(tc, generated_hopf_link_tightens_to_8_pi);
