@@ -105,9 +105,10 @@ bool tk_escape_converged(const tk_run *r)
  * seeds of four (61.00998, median 61.00838); the same start tightened on
  * 245 vertices alone for 150 s (polished, with escapes) reached 61.0535
  * and 61.0815 for seeds 1 and 2, and refined from there to 489 for 450 s
- * without escapes 60.99448 and 61.02733.  Polished at its coarsest level,
- * three seeds of four end below the atlas (60.99433 for seed 1, median
- * 60.99468).  Not the first tightening's level, before any try: the
+ * without escapes 60.99448 and 61.02733.  Polished at its coarsest level
+ * (the first tightening's too), three seeds of four ended below the atlas
+ * (60.99433 for seed 1, median 60.99468); as here, seed 1 ends at
+ * 60.99435.  Not the first tightening's level, before any try: the
  * disguised figure-eight of an_explored_try_leaves_a_coarse_trap, whose
  * first stall (55.30, kinks at the curvature bound) is where exploring
  * leaves for the tight knot's basin, crawled down from there under the
