@@ -1816,6 +1816,24 @@ static double fall_over(const tk_step_report *h, size_t from, size_t n, size_t w
     return (before - recent) / recent;
 }
 
+/* The trefoil from the round torus (200 vertices) set up to be tightened
+ * at 600 vertices, coarse to fine from 150, with a step budget too large
+ * for any level's share to end it. */
+static tk_run *torus_trefoil_at_600(int escapes, tk_curve **c, tk_options *o)
+{
+    ck_assert_int_eq(tk_generate_torus(2, 3, 200, c, NULL), TK_OK);
+    *o = (tk_options)TK_OPTIONS_INIT;
+    o->autoscale = true;
+    o->vertices = 600;
+    o->escapes = escapes;
+    o->max_steps = 1000000;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(*c, o, &run, &err), TK_OK);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, 150);
+    return run;
+}
+
 /* A coarse level moves on when its ropelength fell by less than 1e-4 over
  * 200 steps counted for a mean edge of a tenth of the diameter: on a
  * polygon with shorter edges, as many more steps as they are shorter
@@ -1830,16 +1848,9 @@ START_TEST(a_fine_coarse_level_waits_as_many_more_steps)
     if (quick() && tkt_skip("a_fine_coarse_level_waits_as_many_more_steps", LONG_RUN))
         return;
     tk_curve *c = NULL;
-    ck_assert_int_eq(tk_generate_torus(2, 3, 200, &c, NULL), TK_OK);
-    tk_options o = TK_OPTIONS_INIT;
-    o.autoscale = true;
-    o.vertices = 600;
-    o.escapes = 0;
-    o.max_steps = 1000000;
-    tk_run *run = NULL;
+    tk_options o;
+    tk_run *run = torus_trefoil_at_600(0, &c, &o);
     tk_error err;
-    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
-    ck_assert_uint_eq(tk_run_curve(run)->nvert, 150);
     while (tk_run_curve(run)->nvert < o.vertices && tk_run_latest(run)->step < 20000)
         ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
     ck_assert_uint_eq(tk_run_curve(run)->nvert, o.vertices);
@@ -1920,16 +1931,9 @@ START_TEST(the_coarsest_level_of_a_try_is_polished_first)
     if (quick() && tkt_skip("the_coarsest_level_of_a_try_is_polished_first", LONG_RUN))
         return;
     tk_curve *c = NULL;
-    ck_assert_int_eq(tk_generate_torus(2, 3, 200, &c, NULL), TK_OK);
-    tk_options o = TK_OPTIONS_INIT;
-    o.autoscale = true;
-    o.vertices = 600;
-    o.escapes = 1;
-    o.max_steps = 1000000;
-    tk_run *run = NULL;
+    tk_options o;
+    tk_run *run = torus_trefoil_at_600(1, &c, &o);
     tk_error err;
-    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
-    ck_assert_uint_eq(tk_run_curve(run)->nvert, 150);
     size_t nh = 0;
     const tk_step_report *h = tk_run_history(run, &nh);
     /* until the explored try has left its coarse polygon */
