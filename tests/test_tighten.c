@@ -1816,6 +1816,44 @@ static double fall_over(const tk_step_report *h, size_t from, size_t n, size_t w
     return (before - recent) / recent;
 }
 
+/* The coarse level of report `from`'s polygon, checked against the rule
+ * (a_fine_coarse_level_waits_as_many_more_steps, below): the step of
+ * report i was judged after its motion, on the reports before it (the
+ * mean edge: report i - 1's ropelength over report i's edges), and the
+ * level moves on at its first stall, or, polished, each stall (its
+ * bound a third smaller at each level) or 20 steps in a row with a
+ * residual below 1e-3 take it a level down, and the stall of the fourth
+ * level moves it on (a coarse polygon keeps all four: 0.3 h^2 is above
+ * the options' 3e-4).  A level that begins at step i's watch starts its
+ * window at report i; a move-on shows as report i + 1's count or
+ * restarts.  The report where it moved on, or 0 if it did not. */
+static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t from, bool polished,
+                                   size_t *first_stall)
+{
+    int level = 0;
+    *first_stall = 0;
+    for (size_t i = from + 1; i + 1 < nh; i++) {
+        double edge = h[i - 1].ropelength / (2.0 * (double)h[i].vertices);
+        size_t window = edge >= 0.1 ? 200 : (size_t)lround(200.0 * 0.1 / edge);
+        bool critical = polished && i >= from + 20;
+        for (size_t k = i >= 20 ? i - 20 : 0; k < i && critical; k++)
+            critical = h[k].residual < 1e-3;
+        bool stall = fall_over(h, from, i, window) < 1e-4 * pow(1.0 / 3.0, level) || critical;
+        bool moved = h[i + 1].vertices != h[i].vertices || h[i + 1].restarts != h[i].restarts;
+        ck_assert_msg(moved == (stall && level == (polished ? 4 : 0)),
+                      "step %ld at level %d (since report %zu): %s, %s", h[i].step, level, from,
+                      stall ? "stalled" : "going on", moved ? "moved on" : "stayed");
+        if (moved)
+            return i;
+        if (stall) {
+            *first_stall = *first_stall ? *first_stall : i;
+            level++;
+            from = i;
+        }
+    }
+    return 0;
+}
+
 /* The trefoil from the round torus (200 vertices) set up to be tightened
  * at 600 vertices, coarse to fine from 150, with a step budget too large
  * for any level's share to end it. */
@@ -1854,31 +1892,20 @@ START_TEST(a_fine_coarse_level_waits_as_many_more_steps)
     while (tk_run_curve(run)->nvert < o.vertices && tk_run_latest(run)->step < 20000)
         ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
     ck_assert_uint_eq(tk_run_curve(run)->nvert, o.vertices);
-    size_t nh = 0, from = 0, levels = 0;
+    size_t nh = 0, from = 0, levels = 0, stall = 0, i;
     const tk_step_report *h = tk_run_history(run, &nh);
     double most = 1.0;
-    /* The step of report i was judged after its motion, on the reports
-     * before it (the mean edge: report i - 1's ropelength over report i's
-     * edges); a move-on shows as report i + 1's count.  A level's window
-     * starts at its first report. */
-    for (size_t i = 1; i + 1 < nh; i++) {
+    /* every level, the final one too (which does not move on) */
+    while ((i = coarse_level_checked(h, nh, from, false, &stall)) > 0) {
         double edge = h[i - 1].ropelength / (2.0 * (double)h[i].vertices);
-        double scale = fmax(1.0, 0.1 / edge);
         size_t window = edge >= 0.1 ? 200 : (size_t)lround(200.0 * 0.1 / edge);
-        double fall = fall_over(h, from, i, window);
-        bool due = fall < 1e-4; /* false while NAN */
-        bool moved = h[i + 1].vertices != h[i].vertices;
-        ck_assert_msg(due == moved, "step %ld on %zu vertices: window %zu, fall %.3g, %s",
-                      h[i].step, h[i].vertices, window, fall, moved ? "moved on" : "stayed");
-        if (moved) {
-            printf("T(2,3) at 600: the %zu-vertex level moved on at step %ld after %zu steps "
-                   "(window %zu), ropelength %.5f\n",
-                   h[i].vertices, h[i].step, i + 1 - from, window, h[i].ropelength);
-            ck_assert_uint_eq(h[i + 1].vertices, 2 * h[i].vertices);
-            most = fmax(most, scale);
-            from = i + 1;
-            levels++;
-        }
+        printf("T(2,3) at 600: the %zu-vertex level moved on at step %ld after %zu steps "
+               "(window %zu), ropelength %.5f\n",
+               h[i].vertices, h[i].step, i + 1 - from, window, h[i].ropelength);
+        ck_assert_uint_eq(h[i + 1].vertices, 2 * h[i].vertices);
+        most = fmax(most, fmax(1.0, 0.1 / edge));
+        from = i + 1;
+        levels++;
     }
     ck_assert_uint_eq(levels, 2);
     ck_assert_double_ge(most, 1.5); /* the rule in steps alone would differ */
@@ -1886,41 +1913,6 @@ START_TEST(a_fine_coarse_level_waits_as_many_more_steps)
     tk_curve_free(&c);
 }
 END_TEST
-
-/* The coarse level of report `from`'s polygon, checked against the rule
- * above: it moves on at its first stall, or, polished, each stall (its
- * bound a third smaller at each level) or 20 steps in a row with a
- * residual below 1e-3 take it a level down, and the stall of the fourth
- * level moves it on (a coarse polygon keeps all four: 0.3 h^2 is above
- * the options' 3e-4).  A level that begins at step i's watch starts its
- * window at report i; a move-on shows as report i + 1's count or
- * restarts.  The report where it moved on, or 0 if it did not. */
-static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t from, bool polished,
-                                   size_t *first_stall)
-{
-    int level = 0;
-    *first_stall = 0;
-    for (size_t i = from + 1; i + 1 < nh; i++) {
-        double edge = h[i - 1].ropelength / (2.0 * (double)h[i].vertices);
-        size_t window = edge >= 0.1 ? 200 : (size_t)lround(200.0 * 0.1 / edge);
-        bool critical = polished && i >= from + 20;
-        for (size_t k = i >= 20 ? i - 20 : 0; k < i && critical; k++)
-            critical = h[k].residual < 1e-3;
-        bool stall = fall_over(h, from, i, window) < 1e-4 * pow(1.0 / 3.0, level) || critical;
-        bool moved = h[i + 1].vertices != h[i].vertices || h[i + 1].restarts != h[i].restarts;
-        ck_assert_msg(moved == (stall && level == (polished ? 4 : 0)),
-                      "step %ld at level %d (since report %zu): %s, %s", h[i].step, level, from,
-                      stall ? "stalled" : "going on", moved ? "moved on" : "stayed");
-        if (moved)
-            return i;
-        if (stall) {
-            *first_stall = *first_stall ? *first_stall : i;
-            level++;
-            from = i;
-        }
-    }
-    return 0;
-}
 
 /* With escapes, the coarsest level is where the tries are judged
  * (escape.c), so a try's is polished before it is left; the first
