@@ -1820,9 +1820,9 @@ static double fall_over(const tk_step_report *h, size_t from, size_t n, size_t w
  * (a_fine_coarse_level_waits_as_many_more_steps, below): the step of
  * report i was judged after its motion, on the reports before it (the
  * mean edge: report i - 1's ropelength over report i's edges), and the
- * level moves on at its first stall, or, polished, each stall (its
- * bound a third smaller at each level) or 20 steps in a row with a
- * residual below 1e-3 take it a level down, and the stall of the fourth
+ * level moves on at its first stall (or 20 steps in a row with a
+ * residual below 1e-3), or, polished, each such stall (its bound a third
+ * smaller at each level) takes it a level down, and the stall of the fourth
  * level moves it on (a coarse polygon keeps all four: 0.3 h^2 is above
  * the options' 3e-4).  A level that begins at step i's watch starts its
  * window at report i; a move-on shows as report i + 1's count or
@@ -1835,7 +1835,7 @@ static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t fr
     for (size_t i = from + 1; i + 1 < nh; i++) {
         double edge = h[i - 1].ropelength / (2.0 * (double)h[i].vertices);
         size_t window = edge >= 0.1 ? 200 : (size_t)lround(200.0 * 0.1 / edge);
-        bool critical = polished && i >= from + 20;
+        bool critical = i >= from + 20; /* (the watch's rule on every level) */
         for (size_t k = i >= 20 ? i - 20 : 0; k < i && critical; k++)
             critical = h[k].residual < 1e-3;
         bool stall = fall_over(h, from, i, window) < 1e-4 * pow(1.0 / 3.0, level) || critical;
