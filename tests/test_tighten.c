@@ -1816,6 +1816,15 @@ static double fall_over(const tk_step_report *h, size_t from, size_t n, size_t w
     return (before - recent) / recent;
 }
 
+/* The window of the watch judging report i's step: 200 steps for a mean
+ * edge (report i - 1's ropelength over report i's edges) of a tenth of
+ * the diameter or more, as many more as it is shorter. */
+static size_t window_at(const tk_step_report *h, size_t i)
+{
+    double edge = h[i - 1].ropelength / (2.0 * (double)h[i].vertices);
+    return edge >= 0.1 ? 200 : (size_t)lround(200.0 * 0.1 / edge);
+}
+
 /* The coarse level of report `from`'s polygon, checked against the rule
  * (a_fine_coarse_level_waits_as_many_more_steps, below): the step of
  * report i was judged after its motion, on the reports before it (the
@@ -1833,8 +1842,7 @@ static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t fr
     int level = 0;
     *first_stall = 0;
     for (size_t i = from + 1; i + 1 < nh; i++) {
-        double edge = h[i - 1].ropelength / (2.0 * (double)h[i].vertices);
-        size_t window = edge >= 0.1 ? 200 : (size_t)lround(200.0 * 0.1 / edge);
+        size_t window = window_at(h, i);
         bool critical = i >= from + 20; /* (the watch's rule on every level) */
         for (size_t k = i >= 20 ? i - 20 : 0; k < i && critical; k++)
             critical = h[k].residual < 1e-3;
@@ -1897,13 +1905,12 @@ START_TEST(a_fine_coarse_level_waits_as_many_more_steps)
     double most = 1.0;
     /* every level, the final one too (which does not move on) */
     while ((i = coarse_level_checked(h, nh, from, false, &stall)) > 0) {
-        double edge = h[i - 1].ropelength / (2.0 * (double)h[i].vertices);
-        size_t window = edge >= 0.1 ? 200 : (size_t)lround(200.0 * 0.1 / edge);
+        size_t window = window_at(h, i);
         printf("T(2,3) at 600: the %zu-vertex level moved on at step %ld after %zu steps "
                "(window %zu), ropelength %.5f\n",
                h[i].vertices, h[i].step, i + 1 - from, window, h[i].ropelength);
         ck_assert_uint_eq(h[i + 1].vertices, 2 * h[i].vertices);
-        most = fmax(most, fmax(1.0, 0.1 / edge));
+        most = fmax(most, (double)window / 200.0);
         from = i + 1;
         levels++;
     }
