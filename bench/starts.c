@@ -4,9 +4,11 @@
  * tightened at the same resolution for the same wall time, and each run
  * prints its final ropelength, its excess over the best known value, when
  * it came within 0.5% and 0.1% of it on its final polygon, the escapes it
- * tried and how many improved, and why it stopped (a run whose knot type
- * changed fails, and says so there).  Two starts of one type that end apart
- * found different critical configurations: at most one is tight.
+ * tried and how many improved, the share of its time spent on its knot
+ * type (the start's and every resampled or deformed curve's invariants),
+ * and why it stopped (a run whose knot type changed fails, and says so
+ * there).  Two starts of one type that end apart found different
+ * critical configurations: at most one is tight.
  * Prints figures; never fails on time.
  *
  * With --atlas each start is tightened instead to the vertex count of the
@@ -233,9 +235,11 @@ static void run_start(bench *b, const start *s, unsigned long long seed, size_t 
         if (t.rescales > 0)
             snprintf(rescaled, sizeof rescaled, "%ld<%.1e", t.rescales, t.largest_rescale);
         snprintf(line, sizeof line,
-                 "%-9s %-7s %4llu %8zu %8ld %11.5f %10s %9s %9s %5zu %5zu %6ld %11s  %s%s%s\n",
+                 "%-9s %-7s %4llu %8zu %8ld %11.5f %10s %9s %9s %5zu %5zu %6ld %11s %7.3f%%  "
+                 "%s%s%s\n",
                  s->name, s->type, seed, last->vertices, last->step, last->ropelength, excess, w5,
-                 w1, ne, improved, t.undone_steps, rescaled, tk_stop_reason_name(why),
+                 w1, ne, improved, t.undone_steps, rescaled,
+                 t.total > 0.0 ? 100.0 * t.invariants / t.total : 0.0, tk_stop_reason_name(why),
                  rc ? ": " : "", rc ? err.message : "");
         if (rc == TK_OK) {
             b->rope[slot] = last->ropelength;
@@ -392,9 +396,10 @@ int main(int argc, char **argv)
         printf("starts at resolution %g, %.0f s each, %ld at a time; excess over the best known "
                "value; within: first time on the final polygon\n\n",
                b.resolution, b.seconds, jobs);
-    printf("%-9s %-7s %4s %8s %8s %11s %10s %9s %9s %5s %5s %6s %11s  %s\n", "start", "type",
-           "seed", "vertices", "steps", "ropelength", "excess", b.atlas ? "within.1%" : "within.5%",
-           b.atlas ? "at.atlas" : "within.1%", "esc", "impr", "undone", "rescaled", "stop");
+    printf("%-9s %-7s %4s %8s %8s %11s %10s %9s %9s %5s %5s %6s %11s %8s  %s\n", "start",
+           "type", "seed", "vertices", "steps", "ropelength", "excess",
+           b.atlas ? "within.1%" : "within.5%", b.atlas ? "at.atlas" : "within.1%", "esc", "impr",
+           "undone", "rescaled", "inv.time", "stop");
     fflush(stdout);
     size_t runs = b.ntodo * (size_t)b.seeds;
     b.rope = malloc(runs * sizeof *b.rope);
