@@ -17,6 +17,7 @@
  */
 #include "tk/struts.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -459,20 +460,35 @@ static void strut_from(const tk_strut_finder *f, size_t i, size_t j,
  * strands side by side pair up, leaf by leaf, edges a few apart along
  * them, farther than any bound near the diameter; their boxes cannot
  * tell, the component along u can. */
-static bool pair_beyond(const tk_strut_finder *f, size_t i, size_t j, double b2)
+static bool pair_beyond(const tk_strut_finder *f, size_t i, size_t j, double bound)
 {
     const edge_frame *a = &f->frames[i], *b = &f->frames[j];
     double w[3];
     for (int k = 0; k < 3; k++)
         w[k] = b->mid[k] - a->mid[k];
+    double ww = tk_dot3(w, w);
     double wu = tk_dot3(w, a->dir), cu = tk_dot3(b->dir, a->dir);
+    /* The bound is a difference of terms as large as the edges and their
+     * offset, and |P w| a square root of a difference of squares, so its
+     * rounding is absolute, not relative to the bound: up to about
+     * sqrt(eps) of |w| and the edges (the cancellations), and eps of the
+     * coordinates (the midpoints).  A pair is pruned only when it is
+     * beyond the bound by more than that; otherwise two nearly touching
+     * edges far from the origin would be pruned while their closest
+     * points (which tk_segment_closest gets to eps of the coordinates)
+     * lie within the bound. */
+    double scale = sqrt(ww) + a->half + b->half;
+    double coords = 0.0;
+    for (int k = 0; k < 3; k++)
+        coords = fmax(coords, fmax(fabs(a->mid[k]), fabs(b->mid[k])));
+    double reach = bound + 1e-7 * scale + 64.0 * DBL_EPSILON * (coords + scale);
+    double r2 = reach * reach;
     double along = fmax(fabs(wu) - a->half - b->half * fabs(cu), 0.0);
-    if (along * along > b2)
+    if (along * along > r2)
         return true;
-    double across = sqrt(fmax(tk_dot3(w, w) - wu * wu, 0.0)) -
-                    b->half * sqrt(fmax(1.0 - cu * cu, 0.0));
+    double across = sqrt(fmax(ww - wu * wu, 0.0)) - b->half * sqrt(fmax(1.0 - cu * cu, 0.0));
     across = fmax(across, 0.0);
-    return along * along + across * across > b2;
+    return along * along + across * across > r2;
 }
 
 /* Tests global edges i < j. */
@@ -531,10 +547,25 @@ static double box_gap2(const tree_node *x, const tree_node *y)
     return g2;
 }
 
+/* The largest coordinate magnitude in either box. */
+static double boxes_extent(const tree_node *x, const tree_node *y)
+{
+    double m = 0.0;
+    for (int k = 0; k < 3; k++)
+        m = fmax(m, fmax(fmax(fabs(x->lo[k]), fabs(x->hi[k])),
+                         fmax(fabs(y->lo[k]), fabs(y->hi[k]))));
+    return m;
+}
+
 static bool node_pair_pruned(const query *qy, const tree_node *x, const tree_node *y)
 {
     double g2 = box_gap2(x, y);
-    double b2 = qy->bound * qy->bound;
+    /* The gap is exact to rounding, but an edge pair's distance from
+     * tk_segment_closest is exact only to eps of the coordinates, so a
+     * pair just beyond the bound may measure within it: pruned only
+     * beyond that rounding. */
+    double reach = qy->bound + 64.0 * DBL_EPSILON * boxes_extent(x, y);
+    double b2 = reach * reach;
     if (qy->shortest_mode ? g2 >= b2 : g2 > b2)
         return true;
     return !nodes_may_pass(qy->f, qy->c, x, y, qy->arc_slack);
@@ -548,11 +579,10 @@ static void visit(query *qy, size_t xi, size_t yi)
     if (node_pair_pruned(qy, x, y))
         return;
     if (!x->left && !y->left) {
-        /* (the margin is far above the rounding of the bound and of a
-         * distance; the frames are the fitted curve's, as the boxes) */
+        /* (the frames are the fitted curve's, as the boxes) */
         for (size_t i = x->first; i < x->end; i++)
             for (size_t j = (xi == yi ? i + 1 : y->first); j < y->end; j++)
-                if (!pair_beyond(qy->f, i, j, qy->bound * qy->bound * (1.0 + 1e-9)))
+                if (!pair_beyond(qy->f, i, j, qy->bound))
                     test_pair(qy, i < j ? i : j, i < j ? j : i);
         return;
     }

@@ -962,7 +962,8 @@ int tk_submission_decode(const char *content_type, const tk_query_pair *query, s
     for (size_t i = 0; !rc && !json && i < nquery; i++) { /* a text body's name and options */
         const char *key = query[i].key, *value = query[i].value ? query[i].value : "";
         json_t *name = strcmp(key, "name") ? NULL : json_string(value);
-        if (name) { /* kept with the submission */
+        if (name) { /* kept with the submission; a later name replaces it */
+            json_decref(out->json);
             out->json = json_pack("{s:o}", "name", name);
             rc = set_name(out, json_object_get(out->json, "name"), p);
         } else if (!strcmp(key, "name")) {

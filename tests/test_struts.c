@@ -421,6 +421,57 @@ START_TEST(vertex_that_is_not_a_local_minimum_is_no_strut)
 }
 END_TEST
 
+/* Two V's whose tips nearly touch (1e-10 to 3e-14 apart), one V with an
+ * edge a million units long.  The pair bound for that edge and the
+ * other tip's works with terms as large as the edge, so its rounding is
+ * absolute (about sqrt(eps) of the edge), not relative to the bound: it
+ * once pruned the touching pair, and the tree found no strut where brute
+ * force found the one at the tips (a fuzzed 24-vertex curve, in
+ * tests/fuzz/corpus/vect).  Exact answer: a's points lie at or below the
+ * tip's height and b's at or above the other's, so the one strut is tip
+ * to tip, owned by the edges that start at the tips. */
+START_TEST(nearly_touching_tips_far_from_the_origin)
+{
+    double gaps[3] = {1e-10, 1e-12, 3e-14};
+    for (int g = 0; g < 3; g++) {
+        double d = gaps[g];
+        double o[3] = {2.3444232432646719, -1.3535533905932735, 0.70710678118654746};
+        double a[9] = {o[0] - 1.1196783718730827, o[1] + 1.6464466094067262, o[2] - 0.3,
+                       o[0], o[1], o[2],
+                       o[0] + 0.8660254037844386, o[1] + 1.5, o[2] - 0.7071067811865475};
+        double b[9] = {o[0] - 1.3, o[1] - 1.2, o[2] + d + 0.25,
+                       o[0], o[1], o[2] + d,
+                       o[0] + 1.1e6, o[1] - 1.4e6, o[2] + d + 0.6e6};
+        tk_curve *c = two_open(a, 3, b, 3);
+        double tip = fabs(c->xyz[3 * 4 + 2] - c->xyz[3 * 1 + 2]);
+        tk_strut_finder *f = NULL;
+        ck_assert_int_eq(tk_strut_finder_new(c, &f, NULL), TK_OK);
+        tk_strut_list tree = {0}, brute = {0};
+        for (int rule = 0; rule < 2; rule++) {
+            double bound = tip * (1.0 + 1e-3);
+            ck_assert_int_eq(tk_strut_finder_find(f, c, (tk_arc_rule)rule, tip, bound, &tree,
+                                                  NULL), TK_OK);
+            ck_assert_int_eq(tk_struts_find_brute(c, (tk_arc_rule)rule, tip, bound, &brute,
+                                                  NULL), TK_OK);
+            assert_same_lists(&tree, &brute, "tips");
+            ck_assert_uint_eq(tree.count, 1);
+            ck_assert(tree.items[0].edge[0] == 1 && tree.items[0].edge[1] == 1);
+            ck_assert(tree.items[0].s == 0.0 && tree.items[0].t == 0.0);
+            ck_assert(tree.items[0].length == tip);
+            double shortest = 0.0;
+            ck_assert_int_eq(tk_strut_finder_shortest(f, c, &shortest, NULL, NULL), TK_OK);
+            ck_assert(shortest == tip && shortest == tk_struts_shortest_brute(c, NULL));
+            tk_strut_list_clear(&tree);
+            tk_strut_list_clear(&brute);
+        }
+        tk_strut_list_free(&tree);
+        tk_strut_list_free(&brute);
+        tk_strut_finder_free(&f);
+        tk_curve_free(&c);
+    }
+}
+END_TEST
+
 START_TEST(refit_follows_moved_vertices)
 {
     tk_curve *c = NULL;
@@ -480,6 +531,7 @@ int main(void)
     tcase_add_test(tc, admissible_pairs_of_equilateral_polygon);
     tcase_add_test(tc, contact_at_shared_vertex_is_one_strut);
     tcase_add_test(tc, vertex_that_is_not_a_local_minimum_is_no_strut);
+    tcase_add_test(tc, nearly_touching_tips_far_from_the_origin);
     tcase_add_test(tc, refit_follows_moved_vertices);
     tcase_add_test(tc, kinks_of_a_polygon);
     suite_add_tcase(s, tc);

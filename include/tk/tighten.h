@@ -201,8 +201,12 @@ typedef struct tk_run tk_run;
 typedef int (*tk_progress_fn)(const tk_step_report *step, void *user);
 
 /* Creates a run from a copy of `start`, applying re-resolution and
- * autoscale.  Fails (TK_EINVAL) when the start is not a valid curve, or is
- * thinner than the tube and autoscale is off. */
+ * autoscale.  Fails with TK_EINVAL when the start is not a valid curve, or
+ * is thinner than the tube and autoscale is off; TK_ELIMIT when the
+ * resolution asks for more vertices than a run may have; TK_ETYPE when
+ * the resampled polygon is not of the start's type (a resolution too
+ * coarse to carry the knot: the message names the vertex count);
+ * TK_ENUMERIC or TK_ENOMEM when measuring the start fails. */
 int tk_run_new(const tk_curve *start, const tk_options *opts, tk_run **out, tk_error *err);
 void tk_run_free(tk_run **p);
 

@@ -77,6 +77,9 @@ static void check_measure(const tk_curve *c)
             CHECK(tk_struts_find_brute(c, TK_ARC_ADMISSIBLE, m.thickness, bound, &brute,
                                        NULL) == TK_OK);
             CHECK(brute.count == struts.count);
+            for (size_t k = 0; k < brute.count; k++)
+                CHECK(tk_strut_compare_edges(&brute.items[k], &struts.items[k]) == 0 &&
+                      brute.items[k].length == struts.items[k].length);
             tk_strut_list_free(&brute);
         }
     }
