@@ -205,5 +205,26 @@ col=$(head -n 1 "$tmp/escapes1.tsv" | tr '\t' '\n' | grep -nx escapes | cut -d: 
 [ -n "$col" ] && [ "$(tail -n 1 "$tmp/escapes1.tsv" | cut -f"$col")" -eq "$tries" ]
 check $? "the log's escapes column: $(tail -n 1 "$tmp/escapes1.tsv")"
 
+# Two outputs naming one file, or --log or --struts naming the input, are
+# refused before any work (exit 1), the input untouched; -o IN tightens
+# the file in place.
+cp "$tmp/trefoil.vect" "$tmp/in.vect"
+sum=$(cksum <"$tmp/in.vect")
+for args in "-o $tmp/in.vect --log $tmp/in.vect" "--log $tmp/in.vect" \
+    "--struts $tmp/../$(basename "$tmp")/in.vect" "-o $tmp/same --struts $tmp/same" \
+    "-o $tmp/same2 --log $tmp/./same2"; do
+    cp "$tmp/trefoil.vect" "$tmp/in.vect"
+    # shellcheck disable=SC2086
+    "$tk" tighten "$tmp/in.vect" --autoscale --steps 3 $args >"$tmp/out" 2>"$tmp/err"
+    st=$?
+    [ "$st" -eq 1 ] && grep -q -e "one file" -e "names the input" "$tmp/err" &&
+        [ "$(cksum <"$tmp/in.vect")" = "$sum" ] && [ ! -e "$tmp/same" ] && [ ! -e "$tmp/same2" ]
+    check $? "tighten IN $args: exit $st, $(cat "$tmp/err")"
+done
+cp "$tmp/trefoil.vect" "$tmp/in.vect"
+"$tk" tighten "$tmp/in.vect" --autoscale --steps 3 -o "$tmp/in.vect" --log "$tmp/in.tsv" \
+    >/dev/null 2>"$tmp/err" && "$tk" info "$tmp/in.vect" >/dev/null
+check $? "tighten IN -o IN: in place: $(cat "$tmp/err")"
+
 echo "cli-tighten: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -383,6 +383,53 @@ static const char *input_path(const char *name)
     return strcmp(name, "-") == 0 ? "/dev/stdin" : name;
 }
 
+/* Whether two paths name one file: the same file when both exist (links
+ * and all), else the same name in the same directory. */
+static bool same_file(const char *x, const char *y)
+{
+    struct stat sx, sy;
+    if (!stat(x, &sx) && !stat(y, &sy))
+        return sx.st_dev == sy.st_dev && sx.st_ino == sy.st_ino;
+    char *path[2] = {NULL, NULL};
+    const char *given[2] = {x, y};
+    for (int k = 0; k < 2; k++) {
+        const char *slash = strrchr(given[k], '/');
+        char *dir = slash ? strndup(given[k], (size_t)(slash - given[k]) + 1) : strdup(".");
+        char *real = dir ? realpath(dir, NULL) : NULL;
+        const char *base = slash ? slash + 1 : given[k];
+        size_t n = real ? strlen(real) + strlen(base) + 2 : 0;
+        if (n && (path[k] = malloc(n)) != NULL)
+            snprintf(path[k], n, "%s/%s", real, base);
+        free(real);
+        free(dir);
+    }
+    bool same = path[0] && path[1] ? !strcmp(path[0], path[1]) : !strcmp(x, y);
+    free(path[0]);
+    free(path[1]);
+    return same;
+}
+
+/* A run's outputs each a file of its own, and none but -o the input
+ * (written at the end, -o IN tightens the file in place; --log and
+ * --struts would overwrite the knot before it is read back): refused
+ * before any work, as a usage error. */
+static int check_outputs(const char *input, const char *const out[3])
+{
+    static const char *const flag[3] = {"-o", "--struts", "--log"};
+    for (int i = 0; i < 3; i++) {
+        if (!out[i])
+            continue;
+        for (int j = 0; j < i; j++)
+            if (out[j] && same_file(out[i], out[j]))
+                return usage_error("tighten", "%s and %s name one file (%s): each output needs "
+                                   "its own", flag[j], flag[i], out[i]);
+        if (i > 0 && strcmp(input, "-") && same_file(out[i], input))
+            return usage_error("tighten", "%s names the input %s: it would be lost", flag[i],
+                               input);
+    }
+    return EXIT_OK;
+}
+
 /* Prints a JSON value on one line, numbers with 17 significant digits so
  * that they read back as the same doubles.  Takes the reference. */
 static int print_json(json_t *value)
@@ -826,6 +873,9 @@ static int cmd_tighten(int argc, char **argv)
         return usage_error("tighten", "--re-resolve needs --resolution (the vertices per unit "
                                       "ropelength to keep)");
     const char *name = a.pos[0];
+    const char *const outputs[3] = {a.output, a.struts_out, a.log_out};
+    if (check_outputs(name, outputs) != EXIT_OK)
+        return EXIT_USAGE;
     tk_error err;
     tk_error_clear(&err);
     tk_curve *c = NULL;
