@@ -60,8 +60,12 @@ int tk_field_set(const tk_field *f, void *record, double x, tk_error *err)
     if (f->kind != TK_KIND_REAL && isfinite(x) && x != floor(x))
         return tk_error_set(err, TK_EINVAL, "option '%s': must be a whole number, not %.17g",
                             label(f), x);
+    /* (NaN: a JSON null, the only way to give one) */
+    if (!measured && isnan(x))
+        return tk_error_set(err, TK_EINVAL, "option '%s': must be a number from %.16g to %.16g, "
+                            "not null", label(f), f->min, f->max);
     if (!measured && !(x >= f->min && x <= f->max))
-        return tk_error_set(err, TK_EINVAL, "option '%s': must be from %.6g to %.6g, not %.17g",
+        return tk_error_set(err, TK_EINVAL, "option '%s': must be from %.16g to %.16g, not %.17g",
                             label(f), f->min, f->max, x);
     char *p = (char *)record + f->offset;
     switch (f->kind) {

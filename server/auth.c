@@ -32,9 +32,12 @@ int tk_tokens_load(const char *path, tk_tokens **out, tk_error *err)
     size_t cap = 0;
     int rc = t ? TK_OK : tk_error_set(err, TK_ENOMEM, "out of memory");
     for (long no = 1; !rc && getline(&line, &cap, f) >= 0; no++) {
-        line[strcspn(line, "#\r\n")] = '\0';
+        /* a comment is a whole line: a '#' inside a token is the token's */
+        line[strcspn(line, "\r\n")] = '\0';
         char name[64], token[512], mark[16], extra;
-        int k = sscanf(line, "%63s %511s %15s %c", name, token, mark, &extra);
+        int k = line[strspn(line, " \t")] == '#'
+                    ? 0
+                    : sscanf(line, "%63s %511s %15s %c", name, token, mark, &extra);
         if (k <= 0)
             continue; /* blank or a comment */
         entry e = {.admin = k >= 3 && !strcmp(mark, "admin")};
@@ -48,6 +51,10 @@ int tk_tokens_load(const char *path, tk_tokens **out, tk_error *err)
             rc = tk_error_set(err, TK_EPARSE, "%s:%ld: expected 'NAME TOKEN' or 'NAME "
                               "sha256:HEX' (64 hex digits; a name of at most 62 bytes, a token of at most 510), "
                               "then optionally 'admin'", path, no);
+        else if (!hashed && strlen(token) < TK_TOKEN_MIN)
+            rc = tk_error_set(err, TK_EPARSE, "%s:%ld: the token is %zu characters; a token "
+                              "needs at least %d, or one a client could guess", path, no,
+                              strlen(token), TK_TOKEN_MIN);
         else if (!hashed && gnutls_hash_fast(GNUTLS_DIG_SHA256, token, strlen(token), e.hash))
             rc = tk_error_set(err, TK_EIO, "--tokens: cannot hash a token");
         else if (!(grown = realloc(t->e, (t->n + 1) * sizeof *grown)))

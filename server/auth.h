@@ -4,8 +4,11 @@
  *   alice   sha256:2bb80d537b1da3e38bd30361aa855686bde0eacd7162fef6a25fe97bf527a25b
  *   bob     s3cret-bob-token                                 admin
  *
- * A token is given as it is or as "sha256:" and the 64 hex digits of its
- * SHA-256, so that the file need hold no secret; only the hashes are kept.
+ * A token is given as it is (at least TK_TOKEN_MIN characters) or as
+ * "sha256:" and the 64 hex digits of its SHA-256, so that the file need
+ * hold no secret; only the hashes are kept.  A line whose first
+ * non-blank character is '#' is a comment; a '#' elsewhere belongs to the
+ * token.
  * A request names its client with "Authorization: Bearer TOKEN".
  */
 #ifndef TK_SERVER_AUTH_H
@@ -14,6 +17,9 @@
 #include <stdbool.h>
 
 #include "tk/error.h"
+
+/* Shorter tokens are refused when the file is read. */
+#define TK_TOKEN_MIN 16
 
 typedef struct tk_tokens tk_tokens;
 

@@ -73,7 +73,9 @@ START_TEST(bad_values_name_the_field)
                             {"steps", "-3"},       {"steps", "1e12"},     {"time", "x"},
                             {"residual", "inf"},   {"autoscale", "maybe"}, {"escapes", "1001"},
                             {"seed", "-1"},        {"overstep", "0.5"},   {"radius", "1 2"},
-                            {"re_resolve", "1"},   {"coarse", ""},        {"steps", "0x10"}};
+                            {"re_resolve", "1"},   {"coarse", ""},        {"steps", "0x10"},
+                            /* not exact as a JSON number (nor as a double) */
+                            {"seed", "9007199254740992"}, {"seed", "9007199254740993"}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         tk_options o = TK_OPTIONS_INIT, before = o;
         const tk_field *f = tk_field_find(tk_option_fields, tk_option_nfields, bad[i][0]);
@@ -99,7 +101,7 @@ START_TEST(options_round_trip_through_text_and_json)
     const char *set[][2] = {{"radius", "0.75"}, {"lambda", "1.5"},  {"resolution", "7.5"},
                             {"autoscale", "yes"}, {"steps", "120"},  {"time", "2.5"},
                             {"residual", "1e-3"}, {"overstep", "2e-5"}, {"re_resolve", "0.05"},
-                            {"coarse", "false"}, {"escapes", "3"},   {"seed", "9007199254740992"}};
+                            {"coarse", "false"}, {"escapes", "3"},   {"seed", "9007199254740991"}};
     for (size_t i = 0; i < sizeof set / sizeof set[0]; i++) {
         tk_error err;
         const tk_field *f = tk_field_find(tk_option_fields, tk_option_nfields, set[i][0]);
@@ -108,7 +110,7 @@ START_TEST(options_round_trip_through_text_and_json)
     ck_assert(o.radius == 0.75 && o.lambda == 1.5 && o.resolution == 7.5 && o.autoscale);
     ck_assert(o.max_steps == 120 && o.max_seconds == 2.5 && o.min_residual == 1e-3);
     ck_assert(o.overstep_tolerance == 2e-5 && o.re_resolve == 0.05 && !o.coarse_to_fine);
-    ck_assert(o.escapes == 3 && o.seed == 9007199254740992ULL);
+    ck_assert(o.escapes == 3 && o.seed == 9007199254740991ULL);
     json_t *j = tk_json_options(&o);
     /* only the named fields, each once */
     size_t named = 0;
@@ -145,6 +147,19 @@ START_TEST(bad_json_points_at_the_option)
                          TK_EINVAL);
         ck_assert_str_eq(bad, names[i]);
         ck_assert_msg(strstr(err.message, names[i]) != NULL, "%s", err.message);
+        json_decref(j);
+    }
+    /* a null says so, not "nan"; a seed beyond 2^53 is refused, not rounded */
+    const char *nulls[][2] = {{"{\"time\": null}", "not null"},
+                              {"{\"seed\": 9007199254740993}", "9007199254740991"}};
+    for (size_t i = 0; i < 2; i++) {
+        json_t *j = json_loads(nulls[i][0], 0, NULL);
+        tk_options o = TK_OPTIONS_INIT;
+        tk_error err;
+        ck_assert_int_eq(tk_json_record_set(tk_option_fields, tk_option_nfields, &o, j, NULL,
+                                            &err), TK_EINVAL);
+        ck_assert_msg(strstr(err.message, nulls[i][1]) && !strstr(err.message, "nan"), "%s",
+                      err.message);
         json_decref(j);
     }
 }

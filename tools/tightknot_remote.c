@@ -178,7 +178,32 @@ static bool request(client *c, const char *method, const char *path, const char 
     return true;
 }
 
-/* The problem detail of an error response (or its start). */
+/* What a server sends is printed to a terminal: its control characters
+ * (C0, DEL and, in UTF-8, C1) become '?', so that no text of a job
+ * (another client's name, say) can move the cursor, retitle the window
+ * or print a line of its own. */
+static void make_printable(char *s)
+{
+    unsigned char *p = (unsigned char *)s;
+    for (size_t i = 0; p[i]; i++) {
+        if (p[i] == 0xc2 && p[i + 1] >= 0x80 && p[i + 1] <= 0x9f) {
+            p[i] = p[i + 1] = '?';
+            i++;
+        } else if (p[i] < 0x20 || p[i] == 0x7f) {
+            p[i] = '?';
+        }
+    }
+}
+
+/* text (NULL: "") into out, printable. */
+static char *printable(char *out, size_t size, const char *text)
+{
+    snprintf(out, size, "%s", text ? text : "");
+    make_printable(out);
+    return out;
+}
+
+/* The problem detail of an error response (or its start), printable. */
 static void problem_text(const response *r, char *out, size_t size)
 {
     json_t *doc = r->body.data ? json_loads(r->body.data, 0, NULL) : NULL;
@@ -188,6 +213,7 @@ static void problem_text(const response *r, char *out, size_t size)
     else
         snprintf(out, size, "HTTP %ld: %.200s", r->status, r->body.data ? r->body.data : "");
     json_decref(doc);
+    make_printable(out);
 }
 
 /* ------------------------------------------------------------ files */
@@ -475,6 +501,7 @@ static void finish_item(item *it, const json_t *job)
     it->phase = ITEM_FINISHED;
     const char *state = json_string_value(json_object_get(job, "state"));
     snprintf(it->state, sizeof it->state, "%s", state ? state : "failed");
+    make_printable(it->state);
     it->ropelength = number_or_nan(job, "ropelength");
     it->thickness = number_or_nan(job, "thickness");
     it->residual = number_or_nan(job, "residual");
@@ -486,7 +513,7 @@ static void finish_item(item *it, const json_t *job)
         json_object_get(json_object_get(job, "progress"), "step"));
     const char *error = json_string_value(json_object_get(job, "error"));
     if (error)
-        snprintf(it->message, sizeof it->message, "%s", error);
+        printable(it->message, sizeof it->message, error);
 }
 
 static void make_row(item *it)
@@ -831,8 +858,10 @@ static int cmd_jobs(client *c, const char *what, const run_args *a, bool json, i
             continue;
         }
         json_t *job = json_loadb(r.body.data, r.body.len, 0, NULL);
-        const char *name = json_string_value(json_object_get(job, "name"));
-        const char *state = json_string_value(json_object_get(job, "state"));
+        char name[512], state[64], error[1024];
+        printable(name, sizeof name, json_string_value(json_object_get(job, "name")));
+        printable(state, sizeof state, json_string_value(json_object_get(job, "state")));
+        printable(error, sizeof error, json_string_value(json_object_get(job, "error")));
         if (json && !cancel) {
             printf("%s\n", r.body.data);
         } else if (!strcmp(what, "fetch")) {
@@ -841,19 +870,18 @@ static int cmd_jobs(client *c, const char *what, const run_args *a, bool json, i
             if (!download(c, id, a->out, file))
                 status = REMOTE_FAILED;
             else
-                printf("job %lld (%s): %s/%s.vect, %s/%s.struts.json\n", id, name ? name : "",
+                printf("job %lld (%s): %s/%s.vect, %s/%s.struts.json\n", id, name,
                        a->out, file, a->out, file);
         } else {
             char rope[32], resid[32];
             format_number(rope, sizeof rope, number_or_nan(job, "ropelength"));
             format_number(resid, sizeof resid, number_or_nan(job, "residual"));
-            const char *error = json_string_value(json_object_get(job, "error"));
             printf("%lld\t%s\t%s\tstep %lld\tropelength %s\tresidual %s%s%s\n", id,
-                   name ? name : "", cancel ? (r.status == 202 ? "cancelling" : "cancelled")
-                                            : (state ? state : "?"),
+                   name, cancel ? (r.status == 202 ? "cancelling" : "cancelled")
+                                : state[0] ? state : "?",
                    (long long)json_integer_value(
                        json_object_get(json_object_get(job, "progress"), "step")),
-                   rope, resid, error ? "\terror " : "", error ? error : "");
+                   rope, resid, error[0] ? "\terror " : "", error);
         }
         json_decref(job);
         free(r.body.data);

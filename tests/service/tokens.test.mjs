@@ -1,7 +1,7 @@
 // Tokens (tightknotd --tokens FILE): every request but health, the page
 // and a preflight needs a token of the file (401 otherwise); a job records
 // the name that submitted it, a name lists, reads and cancels its own jobs
-// (others' are 404 to read and 403 to cancel), an admin name all; a name
+// (others' are 404 to read and to cancel, as if not there), an admin name all; a name
 // has at most --jobs-per-name jobs queued or running, and stores at most
 // --bytes-per-name (429).  The remote
 // client sends --token or $TIGHTKNOT_TOKEN.  A daemon on an address other
@@ -16,7 +16,7 @@ import { join } from 'node:path';
 import { CLI, DAEMON, cli, sleep, startDaemon, stopAll, tempDir } from './lib.mjs';
 
 const SQUARE = 'VECT\n1 4 0\n-4\n0\n1 0 0\n0 1 0\n-1 0 0\n0 -1 0\n';
-const TOKENS = { alice: 'alice-secret-1', carol: 'carol-secret-3', root: 'root-secret-9' };
+const TOKENS = { alice: 'alice-secret-00001', carol: 'carol-secret-00003', root: 'root-secret-000009' };
 const sha = (t) => createHash('sha256').update(t).digest('hex');
 
 let d, dir;
@@ -39,7 +39,7 @@ before(async () => {
     TREFOIL = await cli(['generate', 'torus', '2', '3']);
     // alice by hash (the file holds no secret), carol as is, root admin
     writeFileSync(join(dir, 'tokens'), `# clients\nalice sha256:${sha(TOKENS.alice)}\n` +
-        `carol   ${TOKENS.carol}   # a comment\n\nroot ${TOKENS.root} admin\n`);
+        `carol   ${TOKENS.carol}\n  # a comment (only ever a whole line)\n\nroot ${TOKENS.root} admin\n`);
     d = await startDaemon({ workers: 1, args: ['--tokens', join(dir, 'tokens'), '--jobs-per-name', '2'] });
 });
 
@@ -78,9 +78,15 @@ test('a name sees, reads and cancels its own jobs; an admin all', async () => {
         assert.equal((await d.get(`/v1/jobs/${a.json.id}${part}`, as('alice'))).status, 200, part);
         assert.equal((await d.get(`/v1/jobs/${a.json.id}${part}`, as('root'))).status, 200, part);
     }
+    // another name's job is not there to cancel either: the same 404 as
+    // for a job that never was, neither its owner nor its existence shown
     const refused = await d.del(`/v1/jobs/${a.json.id}`, as('carol'));
-    assert.equal(refused.status, 403, refused.text);
-    assert.match(refused.json.detail, /alice/);
+    assert.equal(refused.status, 404, refused.text);
+    assert.doesNotMatch(refused.text, /alice/);
+    const never = await d.del('/v1/jobs/999999', as('carol'));
+    assert.equal(never.status, 404, never.text);
+    assert.equal(refused.json.detail.replace(String(a.json.id), 'N'),
+        never.json.detail.replace('999999', 'N'));
     assert.notEqual((await d.get(`/v1/jobs/${a.json.id}`, as('alice'))).json.state, 'cancelled');
     const cancelled = await d.del(`/v1/jobs/${a.json.id}`, as('root'));
     assert.ok([200, 202].includes(cancelled.status), cancelled.text);
@@ -165,7 +171,7 @@ test('another address than loopback needs tokens or --allow-anonymous; a bad tok
     assert.match(anon.out, /^tightknotd: listening on http:\/\/0\.0\.0\.0:\d+\//);
     const tok = await launch(['--bind', '0.0.0.0', '--port', '0', '--db', db, '--tokens', join(dir, 'tokens')]);
     assert.match(tok.out, /^tightknotd: listening on/);
-    writeFileSync(join(dir, 'bad'), 'alice ok\nbob sha256:12345\n');
+    writeFileSync(join(dir, 'bad'), 'alice ok-and-long-enough\nbob sha256:12345\n');
     const bad = await launch(['--port', '0', '--db', db, '--tokens', join(dir, 'bad')]);
     assert.equal(bad.code, 2);
     assert.match(bad.err, /bad:2: expected/);

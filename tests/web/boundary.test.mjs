@@ -125,18 +125,18 @@ test('a name that is not the daemon\'s (DNS rebinding) gets 421, the page and th
 
 test('with --tokens the page asks for a token once, keeps it for the session, and lists the jobs', async () => {
     const dir = mkdtempSync(join(tmpdir(), 'tk-web-tokens-'));
-    writeFileSync(join(dir, 'tokens'), 'ann ann-token-1\n');
+    writeFileSync(join(dir, 'tokens'), 'ann ann-token-00000001\n');
     const d = await startDaemon(['--tokens', join(dir, 'tokens')]);
     const context = await browser.newContext();
     const p = await context.newPage();
     try {
         const job = await api(d.base, '/v1/jobs?steps=3', { method: 'POST',
-            headers: { 'Content-Type': 'text/plain', Authorization: 'Bearer ann-token-1' }, body: SQUARE });
+            headers: { 'Content-Type': 'text/plain', Authorization: 'Bearer ann-token-00000001' }, body: SQUARE });
         assert.equal(job.status, 202);
         const asked = [];
         p.on('dialog', async (dialog) => {
             asked.push(dialog.message());
-            await dialog.accept('ann-token-1');
+            await dialog.accept('ann-token-00000001');
         });
         await p.goto(`${d.base}/`);
         // the catalogue loads once the token is given
@@ -144,7 +144,7 @@ test('with --tokens the page asks for a token once, keeps it for the session, an
             null, { timeout: 20000 });
         assert.equal(asked.length, 1, `asked ${asked.length} times: ${asked.join(' | ')}`);
         assert.match(asked[0], /needs a token/);
-        assert.equal(await p.evaluate(() => sessionStorage.getItem('tightknot.token')), 'ann-token-1');
+        assert.equal(await p.evaluate(() => sessionStorage.getItem('tightknot.token')), 'ann-token-00000001');
         // its job is listed: the page's requests carry the token
         const listed = await p.evaluate(async () => (await fetch('/v1/jobs', {
             headers: { Authorization: `Bearer ${sessionStorage.getItem('tightknot.token')}` } })).json());
