@@ -172,6 +172,7 @@ test: deps
 	$(Q)$(MAKE) --no-print-directory $(TEST_JOBS) all tests-bin $(BENCH_BIN) lint headers
 	$(Q)$(MAKE) --no-print-directory $(TEST_JOBS) SANITIZE=1 all tests-bin
 	$(Q)$(MAKE) --no-print-directory $(TEST_JOBS) SANITIZE=thread build/tsan/tightknotd build/tsan/tightknot
+	$(Q)$(MAKE) --no-print-directory $(TEST_JOBS) FUZZ=1 fuzz-bin
 	$(Q)./tests/run-all.sh $(BUILD) build/asan $(CATALOGUE)
 
 tests-bin: $(TEST_BIN) $(REPLAY_BIN)
