@@ -6,6 +6,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <limits.h>
 #include <stdarg.h>
 #include <stdatomic.h>
@@ -13,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -42,6 +44,13 @@ struct tk_api {
     tk_store *store;
     atomic_bool refusing;
     atomic_size_t held;           /* bytes of request bodies held, all connections */
+    pthread_mutex_t guard;        /* over held's changes, holders and watches */
+    struct holder *holders;       /* the clients holding bodies, and how much */
+    size_t nholders;
+    struct watch *watches;        /* every open connection with its deadline */
+    pthread_t keeper;             /* cuts those past it (keep_deadlines) */
+    bool keeping;
+    atomic_bool stopping;
     atomic_ullong responses[4];   /* by class: 2xx .. 5xx */
     time_t started;
 };
@@ -66,17 +75,35 @@ static const char *allowed_origin(const tk_api *a, conn *c)
     return origin && listed(a->cfg.allow_origins, origin, strlen(origin)) ? origin : NULL;
 }
 
+/* MHD_get_connection_values's iterator: counts the Host headers. */
+static result count_host(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+{
+    (void)kind, (void)value;
+    if (!strcasecmp(key, MHD_HTTP_HEADER_HOST))
+        (*(int *)cls)++;
+    return MHD_YES;
+}
+
 /* A page in a browser can send requests to any address, loopback too:
  * with a name of its own that resolves here (DNS rebinding) it can even
  * read the answers.  So the Host a request names must be one this daemon
  * serves, and a request a page sends (it carries an Origin) must come from
  * the daemon's own origin (the page it serves) or one allowed with
- * --allow-origin.  0 when the request may pass, else the status to refuse
- * it with (421 or 403), with why. */
-static unsigned boundary(const tk_api *a, conn *c, char *why, size_t size)
+ * --allow-origin, scheme and all.  An HTTP/1.1 request names exactly one
+ * Host (RFC 9112, 3.2): with none or two, which one a proxy in front and
+ * this daemon each read is not the same.  0 when the request may pass,
+ * else the status to refuse it with (400, 421 or 403), with why. */
+static unsigned boundary(const tk_api *a, conn *c, const char *version, char *why, size_t size)
 {
     const char *host = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);
     const char *origin = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Origin");
+    int hosts = 0;
+    MHD_get_connection_values(c, MHD_HEADER_KIND, count_host, &hosts);
+    if (hosts > 1 || (hosts == 0 && strcmp(version, MHD_HTTP_VERSION_1_0))) {
+        snprintf(why, size, "an HTTP/1.1 request names exactly one Host (this one names %d)",
+                 hosts);
+        return 400;
+    }
     if (host) { /* the name without its port; [v6] whole */
         size_t n = host[0] == '[' ? strcspn(host, "]") + 1 : strcspn(host, ":");
         if (!listed(a->hosts, host, n)) {
@@ -85,8 +112,10 @@ static unsigned boundary(const tk_api *a, conn *c, char *why, size_t size)
             return 421;
         }
     }
-    const char *authority = origin ? strstr(origin, "://") : NULL;
-    if (!origin || (authority && host && !strcasecmp(authority + 3, host)) ||
+    /* the daemon's own origin: its scheme, then the Host */
+    const char *scheme = a->tls_cert ? "https://" : "http://";
+    size_t sn = strlen(scheme);
+    if (!origin || (host && !strncasecmp(origin, scheme, sn) && !strcasecmp(origin + sn, host)) ||
         allowed_origin(a, c))
         return 0;
     snprintf(why, size, "requests from pages at '%.200s' are not allowed here (the daemon's "
@@ -98,7 +127,10 @@ static unsigned boundary(const tk_api *a, conn *c, char *why, size_t size)
 typedef struct request {
     char *body;
     size_t len, cap;
-    bool too_large, crowded;
+    bool too_large;
+    int crowded; /* 0, or the budget that refused the body: 1 all clients', 2 its client's */
+    char client[72]; /* 'n' and the token's name, else 'a' and the address */
+    long long due;   /* when its body must be whole (watch.due) */
     const char *who; /* the token's name (with --tokens), else NULL */
     bool admin;
 } request;
@@ -137,6 +169,10 @@ static result send_buffer(tk_api *a, conn *c, unsigned status, const char *type,
         MHD_add_response_header(r, MHD_HTTP_HEADER_CONTENT_TYPE, type);
     for (size_t i = 0; headers && headers[i]; i += 2)
         MHD_add_response_header(r, headers[i], headers[i + 1]);
+    /* no page of another site may frame ours (clickjacking), and no
+     * answer is read as another type than it says */
+    MHD_add_response_header(r, "Content-Security-Policy", "frame-ancestors 'none'");
+    MHD_add_response_header(r, "X-Content-Type-Options", "nosniff");
     const char *origin = allowed_origin(a, c); /* CORS: that page may read it */
     if (origin) {
         MHD_add_response_header(r, "Access-Control-Allow-Origin", origin);
@@ -201,8 +237,14 @@ static result damaged(tk_api *a, conn *c, int64_t id, const char *what, const ch
     return PROBLEM(a, c, 500, "%s", message);
 }
 
+/* A store that cannot be reached or written (TK_EIO: a database down or
+ * restarting, a full disk) is an outage, not a fault of the request or of
+ * ours: 503 and when to try again; the store changed nothing. */
 static result store_problem(tk_api *a, conn *c, int rc, const tk_error *err)
 {
+    static const char *const retry[] = {"Retry-After", "5", NULL};
+    if (rc == TK_EIO)
+        return problem(a, c, 503, NULL, retry, "%s", err->message);
     return PROBLEM(a, c, rc == TK_ENOTFOUND ? 404 : 500, "%s", err->message);
 }
 
@@ -215,7 +257,8 @@ static bool query_count(tk_api *a, conn *c, const char *name, long dflt, long lo
     char *end = NULL;
     errno = 0;
     *out = v ? strtol(v, &end, 10) : dflt;
-    if (!v || (!errno && end != v && !*end && *out >= lo && *out <= hi))
+    /* digits only: strtol would take blanks and a sign first */
+    if (!v || (v[0] >= '0' && v[0] <= '9' && !errno && !*end && *out >= lo && *out <= hi))
         return true;
     *ret = problem(a, c, 400, json_pack("{s:s}", "parameter", name), NULL,
                    "query parameter '%s' must be a whole number from %ld to %ld", name, lo, hi);
@@ -317,12 +360,15 @@ typedef struct query_list {
     size_t n;
 } query_list;
 
-static result collect(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+/* With the lengths, so that a %00 decoded into a key or value shows. */
+static result collect(void *cls, enum MHD_ValueKind kind, const char *key, size_t key_size,
+                      const char *value, size_t value_size)
 {
     (void)kind;
     query_list *q = cls;
     if (q->n < 64)
-        q->pairs[q->n] = (tk_query_pair){key, value};
+        q->pairs[q->n] = (tk_query_pair){key, value, strlen(key) != key_size ||
+                                                         (value && strlen(value) != value_size)};
     q->n++;
     return MHD_YES;
 }
@@ -330,7 +376,7 @@ static result collect(void *cls, enum MHD_ValueKind kind, const char *key, const
 static result post_job(tk_api *a, conn *c, const request *rq)
 {
     query_list q = {.n = 0};
-    MHD_get_connection_values(c, MHD_GET_ARGUMENT_KIND, collect, &q);
+    MHD_get_connection_values_n(c, MHD_GET_ARGUMENT_KIND, collect, &q);
     if (q.n > 64)
         return PROBLEM(a, c, 400, "more than 64 query parameters");
     tk_submission sub;
@@ -401,14 +447,12 @@ static result cancel_job(tk_api *a, conn *c, int64_t id, const request *rq)
     int rc = rq->who ? get_job(a, id, &doc, &err) : TK_OK;
     if (rc)
         return store_problem(a, c, rc, &err);
+    /* another name's job is not there for this one, as for GET: neither
+     * its existence nor its owner shows */
     bool refused = doc && !visible(rq, doc);
-    const char *owner = json_string_value(json_object_get(doc, "owner"));
-    result ret = refused ? PROBLEM(a, c, 403, "job %lld is not yours to cancel: %.64s submitted "
-                                   "it", (long long)id, owner ? owner : "a client without a name")
-                         : MHD_YES;
     json_decref(doc);
     if (refused)
-        return ret;
+        return PROBLEM(a, c, 404, "there is no job %lld", (long long)id);
     rc = tk_pool_cancel(a->pool, id, &doc, &err);
     if (rc == TK_EINVAL && (rc = tk_store_delete(a->store, id, &err)) == TK_OK)
         return send_buffer(a, c, 204, NULL, NULL, 0, NULL); /* ended: it goes */
@@ -778,9 +822,168 @@ static result route(tk_api *a, conn *c, const char *url, const char *method, con
     return problem(a, c, 405, NULL, headers, "%s is not allowed here; use %s", method, allow);
 }
 
+/* ---- one client against the others ---- */
+
+/* The body budget's shares.  A client is the name of the token its
+ * request carries (clients behind one address, a NAT, get a share each; a
+ * name on many addresses is still one), else its address.  It holds at
+ * most a quarter of --max-body-total, or one body of --max-body where that
+ * is more: one client holding slow uploads leaves the others three
+ * quarters (the probe's four 16 MB uploads took it all), yet can always
+ * send one largest body. */
+typedef struct holder {
+    char client[72];
+    size_t bytes;
+} holder;
+
+static size_t share(const tk_api *a)
+{
+    size_t quarter = a->cfg.max_body_total / 4;
+    return quarter > a->cfg.max_body + 1 ? quarter : a->cfg.max_body + 1;
+}
+
+/* Takes `more` bytes of the budget for rq's client: 0, or the budget that
+ * refuses them (request.crowded). */
+static int reserve(tk_api *a, const request *rq, size_t more)
+{
+    pthread_mutex_lock(&a->guard);
+    holder *h = a->holders, *end = h + a->nholders;
+    while (h < end && strcmp(h->client, rq->client))
+        h++;
+    int refused = atomic_load(&a->held) + more > a->cfg.max_body_total ? 1
+                  : (h < end ? h->bytes : 0) + more > share(a)     ? 2
+                                                                   : 0;
+    if (!refused && h == end) {
+        holder *grown = realloc(a->holders, (a->nholders + 1) * sizeof *grown);
+        refused = !grown;
+        if (grown) {
+            a->holders = grown;
+            h = &grown[a->nholders++];
+            *h = (holder){.bytes = 0};
+            snprintf(h->client, sizeof h->client, "%s", rq->client);
+        }
+    }
+    if (!refused) {
+        h->bytes += more;
+        atomic_fetch_add(&a->held, more);
+    }
+    pthread_mutex_unlock(&a->guard);
+    return refused;
+}
+
+static void release(tk_api *a, const request *rq, size_t bytes)
+{
+    if (!bytes)
+        return;
+    pthread_mutex_lock(&a->guard);
+    size_t i = 0;
+    while (i < a->nholders && strcmp(a->holders[i].client, rq->client))
+        i++;
+    if (i < a->nholders && !(a->holders[i].bytes -= bytes))
+        a->holders[i] = a->holders[--a->nholders];
+    atomic_fetch_sub(&a->held, bytes);
+    pthread_mutex_unlock(&a->guard);
+}
+
+/* rq's client (reserve), once its token is checked. */
+static void name_client(conn *c, request *rq)
+{
+    const union MHD_ConnectionInfo *i = MHD_get_connection_info(c,
+                                                                MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+    const struct sockaddr_in *in = i ? (const void *)i->client_addr : NULL;
+    char addr[INET_ADDRSTRLEN] = "?";
+    if (in && in->sin_family == AF_INET)
+        inet_ntop(AF_INET, &in->sin_addr, addr, sizeof addr);
+    snprintf(rq->client, sizeof rq->client, "%c%s", rq->who ? 'n' : 'a', rq->who ? rq->who : addr);
+}
+
+/* Deadlines.  --timeout counts only silence: a client sending a header
+ * line every few seconds kept its connection for ever, and 8 addresses x
+ * 128 of them held every slot (the probe's F12).  libmicrohttpd 0.9.75
+ * has only idle timeouts, and calls us once a head is whole, so we keep
+ * them: each connection, watched from its start (NOTIFY_CONNECTION), is
+ * due to have its head within --head-timeout of its opening or of its
+ * previous answer, then to keep its body up to --min-body-rate (handle),
+ * and is due nothing while it is answered.  A thread looks
+ * every 200 ms and cuts those past due with shutdown(): libmicrohttpd's
+ * thread then reads the end of input and closes the connection as one
+ * the client closed (it has no way for us to answer 408 before a head is
+ * whole).  A watch leaves the list before libmicrohttpd closes its
+ * socket, so under the lock its descriptor is still its own. */
+typedef struct watch {
+    struct watch *prev, *next;
+    int fd;
+    atomic_llong due; /* ms of CLOCK_MONOTONIC; 0: none */
+} watch;
+
+static long long now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (long long)t.tv_sec * 1000 + t.tv_nsec / 1000000;
+}
+
+/* --head-timeout from now (0: none). */
+static long long head_due(const tk_api *a)
+{
+    return a->cfg.head_timeout ? now_ms() + 1000 * (long long)a->cfg.head_timeout : 0;
+}
+
+static void set_due(conn *c, long long due)
+{
+    const union MHD_ConnectionInfo *i = MHD_get_connection_info(c,
+                                                                MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+    if (i && i->socket_context)
+        atomic_store(&((watch *)i->socket_context)->due, due);
+}
+
+static void notify(void *cls, conn *c, void **context, enum MHD_ConnectionNotificationCode code)
+{
+    tk_api *a = cls;
+    watch *w = *context;
+    const union MHD_ConnectionInfo *fd = MHD_get_connection_info(c,
+                                                                 MHD_CONNECTION_INFO_CONNECTION_FD);
+    if (code == MHD_CONNECTION_NOTIFY_STARTED && fd && (w = calloc(1, sizeof *w))) {
+        w->fd = fd->connect_fd;
+        *context = w;
+        set_due(c, head_due(a));
+        pthread_mutex_lock(&a->guard);
+        w->next = a->watches;
+        if (a->watches)
+            a->watches->prev = w;
+        a->watches = w;
+        pthread_mutex_unlock(&a->guard);
+    } else if (code == MHD_CONNECTION_NOTIFY_CLOSED && w) {
+        pthread_mutex_lock(&a->guard);
+        *(w->prev ? &w->prev->next : &a->watches) = w->next;
+        if (w->next)
+            w->next->prev = w->prev;
+        pthread_mutex_unlock(&a->guard);
+        free(w);
+        *context = NULL;
+    }
+}
+
+static void *keep_deadlines(void *cls)
+{
+    tk_api *a = cls;
+    while (!atomic_load(&a->stopping)) {
+        nanosleep(&(struct timespec){.tv_nsec = 200000000}, NULL);
+        long long now = now_ms();
+        pthread_mutex_lock(&a->guard);
+        for (watch *w = a->watches; w; w = w->next) {
+            long long due = atomic_load(&w->due);
+            if (due && now > due && !shutdown(w->fd, SHUT_RDWR))
+                atomic_store(&w->due, 0);
+        }
+        pthread_mutex_unlock(&a->guard);
+    }
+    return NULL;
+}
+
 static void drop_body(tk_api *a, request *rq)
 {
-    atomic_fetch_sub(&a->held, rq->cap);
+    release(a, rq, rq->cap);
     free(rq->body);
     rq->body = NULL;
     rq->len = rq->cap = 0;
@@ -792,15 +995,15 @@ static void drop_body(tk_api *a, request *rq)
 static result handle(void *cls, conn *c, const char *url, const char *method,
                      const char *version, const char *data, size_t *size, void **con_cls)
 {
-    (void)version;
     tk_api *a = cls;
     request *rq = *con_cls;
     bool post = !strcmp(method, "POST");
     if (!rq) {
         if (!(*con_cls = rq = calloc(1, sizeof *rq)))
             return MHD_NO;
+        set_due(c, rq->due = head_due(a)); /* the head is whole: the body's grace */
         char why[600];
-        unsigned refused = boundary(a, c, why, sizeof why);
+        unsigned refused = boundary(a, c, version, why, sizeof why);
         if (refused) /* answered before any body is read */
             return problem(a, c, refused, NULL, NULL, "%s", why);
         if (a->cfg.tokens && needs_token(url, method) &&
@@ -813,12 +1016,20 @@ static result handle(void *cls, conn *c, const char *url, const char *method,
             return problem(a, c, 401, NULL, headers, "this server needs a token: send "
                            "'Authorization: Bearer TOKEN' (one of its --tokens file)");
         }
+        name_client(c, rq);
         const char *length = MHD_lookup_connection_value(c, MHD_HEADER_KIND,
                                                          MHD_HTTP_HEADER_CONTENT_LENGTH);
         rq->too_large = post && length && strtoull(length, NULL, 10) > a->cfg.max_body;
         if (!rq->too_large && !atomic_load(&a->refusing))
             return MHD_YES;
     } else if (*size > 0) {
+        /* each byte buys 1/rate s, never more than --head-timeout in hand:
+         * a body keeps the rate over every such span (an average since
+         * the start would let a fast start buy hours of trickle) */
+        long long most = head_due(a);
+        rq->due = a->cfg.min_body_rate ? rq->due + (long long)(*size * 1000 / a->cfg.min_body_rate)
+                                       : 0;
+        set_due(c, rq->due = rq->due < most ? rq->due : most);
         if (post && !rq->too_large && rq->len + *size > a->cfg.max_body) {
             rq->too_large = true;
             drop_body(a, rq);
@@ -827,13 +1038,15 @@ static result handle(void *cls, conn *c, const char *url, const char *method,
             size_t cap = rq->cap ? rq->cap : 65536;
             while (cap < rq->len + *size + 1)
                 cap *= 2;
+            cap = cap > a->cfg.max_body + 1 ? a->cfg.max_body + 1 : cap; /* never needs more */
             size_t more = cap - rq->cap;
-            char *grown = atomic_fetch_add(&a->held, more) + more > a->cfg.max_body_total
-                              ? NULL
-                              : realloc(rq->body, cap);
+            rq->crowded = reserve(a, rq, more);
+            char *grown = rq->crowded ? NULL : realloc(rq->body, cap);
             if (!grown) {
-                atomic_fetch_sub(&a->held, more);
-                rq->crowded = true;
+                if (!rq->crowded) { /* out of memory: as if the budget were */
+                    release(a, rq, more);
+                    rq->crowded = 1;
+                }
                 drop_body(a, rq);
             } else {
                 rq->body = grown;
@@ -848,6 +1061,7 @@ static result handle(void *cls, conn *c, const char *url, const char *method,
         *size = 0;
         return MHD_YES;
     }
+    set_due(c, 0); /* answered at the client's pace (--timeout) */
     if (atomic_load(&a->refusing)) {
         const char *headers[] = {MHD_HTTP_HEADER_RETRY_AFTER, "10", NULL};
         return problem(a, c, 503, NULL, headers, "the service is shutting down");
@@ -857,6 +1071,10 @@ static result handle(void *cls, conn *c, const char *url, const char *method,
                        a->cfg.max_body);
     if (rq->crowded) {
         const char *headers[] = {MHD_HTTP_HEADER_RETRY_AFTER, "5", NULL};
+        if (rq->crowded == 2)
+            return problem(a, c, 503, NULL, headers, "too many uploads at once from one client "
+                           "(%s): its others hold the %zu bytes one client may; try again when "
+                           "they end", rq->who ? "this name" : "this address", share(a));
         return problem(a, c, 503, NULL, headers, "too many uploads at once (%zu bytes held): "
                        "try again shortly", a->cfg.max_body_total);
     }
@@ -865,7 +1083,8 @@ static result handle(void *cls, conn *c, const char *url, const char *method,
 
 static void request_done(void *cls, conn *c, void **con_cls, enum MHD_RequestTerminationCode toe)
 {
-    (void)c, (void)toe;
+    (void)toe;
+    set_due(c, head_due(cls)); /* the next request's head, on a kept connection */
     if (*con_cls) {
         drop_body(cls, *con_cls);
         free(*con_cls);
@@ -895,13 +1114,19 @@ static bool media_is(const char *type, const char *media)
     return type && !strncasecmp(type, media, n) && strchr("; ", type[n]);
 }
 
-/* A name is shown as a JSON string: UTF-8, no NUL, under 128 bytes. */
+/* A name is shown as a JSON string and printed on terminals: UTF-8 under
+ * 128 bytes, no control character (C0, DEL, C1: escapes, bells and line
+ * breaks would drive the terminal of whoever lists the jobs). */
 static int set_name(tk_submission *out, const json_t *name, tk_problem *p)
 {
-    if (!json_is_string(name) || json_string_length(name) > 127 ||
-        strlen(json_string_value(name)) != json_string_length(name))
-        return refuse(p, 422, "field", "name", "'name' must be text (UTF-8, no NUL) under 128 "
-                      "bytes");
+    const unsigned char *t = (const unsigned char *)json_string_value(name);
+    bool control = false;
+    for (size_t i = 0; t && i < json_string_length(name); i++)
+        control |= t[i] < 0x20 || t[i] == 0x7f || (t[i] == 0xc2 && t[i + 1] >= 0x80 &&
+                                                   t[i + 1] <= 0x9f);
+    if (!json_is_string(name) || json_string_length(name) > 127 || control)
+        return refuse(p, 422, "field", "name", "'name' must be text (UTF-8, no control "
+                      "character) under 128 bytes");
     out->name = json_string_value(name);
     return TK_OK;
 }
@@ -961,14 +1186,19 @@ int tk_submission_decode(const char *content_type, const tk_query_pair *query, s
     }
     for (size_t i = 0; !rc && !json && i < nquery; i++) { /* a text body's name and options */
         const char *key = query[i].key, *value = query[i].value ? query[i].value : "";
+        if (query[i].nul) {
+            rc = refuse(p, 422, "parameter", key, "query parameter '%.60s' holds a NUL byte "
+                        "(%%00)", key);
+            break;
+        }
         json_t *name = strcmp(key, "name") ? NULL : json_string(value);
         if (name) { /* kept with the submission; a later name replaces it */
             json_decref(out->json);
             out->json = json_pack("{s:o}", "name", name);
             rc = set_name(out, json_object_get(out->json, "name"), p);
         } else if (!strcmp(key, "name")) {
-            rc = refuse(p, 422, "field", "name", "'name' must be text (UTF-8, no NUL) under 128 "
-                        "bytes");
+            rc = refuse(p, 422, "field", "name", "'name' must be text (UTF-8, no control "
+                        "character) under 128 bytes");
         } else if (tk_job_option_set_text(&out->options, key, value, &err)) {
             rc = refuse(p, 422, "option", key, "%s", err.message);
         }
@@ -1039,6 +1269,7 @@ int tk_api_start(const tk_api_config *cfg, tk_pool *pool, tk_store *store, tk_ap
     if (!a)
         return tk_error_set(err, TK_ENOMEM, "out of memory");
     *a = (tk_api){.cfg = *cfg, .pool = pool, .store = store, .started = time(NULL)};
+    pthread_mutex_init(&a->guard, NULL);
     if (cfg->web && !(a->web = realpath(cfg->web, NULL))) {
         tk_error_set(err, TK_EIO, "--web: cannot use %s: %s", cfg->web, strerror(errno));
         tk_api_stop(&a);
@@ -1075,7 +1306,11 @@ int tk_api_start(const tk_api_config *cfg, tk_pool *pool, tk_store *store, tk_ap
         (unsigned)cfg->max_connections, MHD_OPTION_PER_IP_CONNECTION_LIMIT,
         (unsigned)cfg->max_per_address, MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg->timeout,
         MHD_OPTION_NOTIFY_COMPLETED, request_done, a, MHD_OPTION_LISTEN_BACKLOG_SIZE, 1024,
-        MHD_OPTION_END);
+        MHD_OPTION_NOTIFY_CONNECTION, notify, a, MHD_OPTION_END);
+    if (a->daemon && !(a->keeping = !pthread_create(&a->keeper, NULL, keep_deadlines, a))) {
+        tk_api_stop(&a);
+        return tk_error_set(err, TK_ENOMEM, "cannot start a thread");
+    }
     if (!a->daemon) {
         tk_error_set(err, TK_EIO, "cannot listen on %s:%zu: %s", cfg->bind, cfg->port,
                      errno ? strerror(errno)
@@ -1114,8 +1349,13 @@ void tk_api_stop(tk_api **p)
 {
     if (!p || !*p)
         return;
-    if ((*p)->daemon)
+    atomic_store(&(*p)->stopping, true);
+    if ((*p)->keeping)
+        pthread_join((*p)->keeper, NULL);
+    if ((*p)->daemon) /* closes the connections: their watches go */
         MHD_stop_daemon((*p)->daemon);
+    free((*p)->holders);
+    pthread_mutex_destroy(&(*p)->guard);
     for (size_t i = 0; i < (*p)->nentries; i++)
         free((*p)->entries[i].name);
     free((*p)->entries);

@@ -15,10 +15,13 @@ typedef struct tk_api_config {
     const char *bind;       /* IPv4 address */
     size_t port;            /* 0: any free one (tk_api_port) */
     size_t max_body;        /* larger bodies get 413 */
-    size_t max_body_total;  /* bodies held at once over all connections: 503 beyond */
+    size_t max_body_total;  /* bodies held at once over all connections, one client a
+                               quarter or one max_body: 503 beyond */
     size_t max_vertices;    /* larger VECT inputs get 422 */
     size_t max_connections, max_per_address;
     size_t timeout;         /* seconds an idle connection is kept */
+    size_t head_timeout;    /* seconds a request's head may take (0: any) */
+    size_t min_body_rate;   /* bytes a second a body averages after head_timeout (0: any) */
     size_t threads;         /* threads answering requests */
     const char *web;        /* the page's files, or NULL */
     const char *catalogue;  /* a directory of *.vect offered by name, or NULL */
@@ -45,6 +48,7 @@ void tk_api_stop(tk_api **p);
  * a catalogue entry's name. */
 typedef struct tk_query_pair {
     const char *key, *value; /* value NULL: no '=' */
+    bool nul;                /* either held a NUL byte (decoded %00) */
 } tk_query_pair;
 
 typedef struct tk_submission {

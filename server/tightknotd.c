@@ -36,11 +36,19 @@ static const tk_field fields[] = {
         "largest knot accepted, after re-resolution"),
     ROW(api.max_body, max_body, SIZE, 16 << 20, 64, 0x1p32, "largest request body in bytes"),
     ROW(api.max_body_total, max_body_total, SIZE, 64 << 20, 64, 0x1p40,
-        "bytes of request bodies held at once over all connections; uploads beyond get 503"),
+        "bytes of request bodies held at once over all connections, by one client (its "
+        "token's name, else its address) at most a quarter of them, or one --max-body where "
+        "that is more; uploads beyond get 503"),
     ROW(api.max_connections, max_connections, SIZE, 1000, 1, 100000, "open connections at once"),
     ROW(api.max_per_address, max_per_address, SIZE, 128, 1, 100000,
         "open connections from one client address"),
     ROW(api.timeout, timeout, SIZE, 10, 1, 3600, "seconds a silent connection is kept open"),
+    ROW(api.head_timeout, head_timeout, SIZE, 20, 0, 3600,
+        "seconds a request's head (its line and headers) may take to arrive, from the "
+        "connection's opening or its previous answer; a slower one is cut (0: any time)"),
+    ROW(api.min_body_rate, min_body_rate, SIZE, 1000, 0, 1e9,
+        "bytes a second a request body must keep up after its head: each byte buys 1/N s, "
+        "never more than --head-timeout seconds in hand; a slower upload is cut (0: any rate)"),
     ROW(api.threads, http_threads, SIZE, 2, 1, 64, "threads answering requests"),
     ROW(lease, lease, REAL, 30, 3, 3600,
         "with a PostgreSQL --db: seconds after which the jobs of a daemon that stopped "
@@ -72,9 +80,10 @@ int main(int argc, char **argv)
                 "requests: idle (default: only CPU nothing else wants), low (niceness 5) or "
                 "normal (a machine shared with other busy programs, which idle could starve)");
     tk_cli_text(&cli, "tokens", 0, "FILE", &tokens_file, "the clients: a line 'NAME TOKEN' "
-                "or 'NAME sha256:HEX' each, 'admin' after it for a name that may cancel any "
-                "job; every request but health and the page then needs 'Authorization: Bearer "
-                "TOKEN', and a name sees its own jobs");
+                "(a token of at least 16 characters) or 'NAME sha256:HEX' each, 'admin' after "
+                "it for a name that may cancel any job, '#' first on a comment line; every "
+                "request but health and the page then needs 'Authorization: Bearer TOKEN', and "
+                "a name sees its own jobs");
     tk_cli_text(&cli, "tls-cert", 0, "FILE", &set.api.tls_cert, "serve HTTPS with this "
                 "certificate (PEM; with --tls-key)");
     tk_cli_text(&cli, "tls-key", 0, "FILE", &set.api.tls_key, "the certificate's private key "
