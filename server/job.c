@@ -33,12 +33,13 @@ json_t *tk_job_new(const char *name, const char *owner, const tk_job_options *o,
 {
     tk_job_options run = *o;
     tk_job_options_complete(&run);
-    json_t *doc = json_pack("{s:o, s:s, s:o, s:{s:i, s:n}, s:I, s:i, s:n, s:n, s:n, s:n, s:n}",
-                            "name", tk_json_text(name), "state", "queued", "options",
+    json_t *doc = json_pack("{s:o, s:s, s:o, s:{s:i, s:n}, s:I, s:i, s:i, s:f, s:n, s:n, s:n, "
+                            "s:n, s:n}", "name", tk_json_text(name), "state", "queued", "options",
                             tk_json_record(tk_job_option_fields, tk_job_option_nfields, &run),
                             "progress", "step", 0, "fraction", "components",
-                            (json_int_t)components, "frames", 0, "stop_reason", "error",
-                            "invariants", "started", "finished");
+                            (json_int_t)components, "frames", 0, "frames_refused", 0,
+                            "paused_seconds", 0.0, "stop_reason", "error", "invariants",
+                            "started", "finished");
     /* figures: measurements unknown until the run has measured */
     for (size_t i = 0; doc && i < tk_step_nfields; i++)
         json_object_set_new(doc, tk_step_fields[i].name,
@@ -66,6 +67,13 @@ void tk_job_set_figures(json_t *doc, const tk_step_report *r, const tk_job_optio
     json_object_set_new(doc, "progress",
                         json_pack("{s:I, s:o}", "step", (json_int_t)r->step, "fraction",
                                   f < 0.0 ? json_null() : json_real(fmin(f, 1.0))));
+}
+
+void tk_job_add(json_t *doc, const char *key, double amount, bool whole)
+{
+    /* 0 when absent: a job stored before the key was */
+    double sum = json_number_value(json_object_get(doc, key)) + amount;
+    json_object_set_new(doc, key, whole ? json_integer((json_int_t)sum) : json_real(sum));
 }
 
 void tk_job_stamp(json_t *doc, const char *key)

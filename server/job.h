@@ -5,11 +5,16 @@
  * of its token, null without tokens), where the job stands (state,
  * progress, timestamps, stop reason, error, frames, knot type) and its
  * latest figures, which are the fields of the engine's step report under
- * their table's names (tk/tighten.h).  The store keeps it as it is, the
+ * their table's names (tk/tighten.h); what the store did to it: frames
+ * refused (frames_refused: beyond its owner's bytes) and the seconds it
+ * was paused by a failing store (paused_seconds, not spent of its time
+ * budget).  The store keeps it as it is, the
  * pool updates it, the routes serve it: no field is listed twice.
  */
 #ifndef TK_SERVER_JOB_H
 #define TK_SERVER_JOB_H
+
+#include <stdbool.h>
 
 #include <jansson.h>
 
@@ -33,6 +38,9 @@ json_t *tk_job_new(const char *name, const char *owner, const tk_job_options *o,
 
 /* Sets the figures of step r and the progress through the budget of o. */
 void tk_job_set_figures(json_t *doc, const tk_step_report *r, const tk_job_options *o);
+
+/* Adds amount to the count (whole) or number doc[key] (0 when absent). */
+void tk_job_add(json_t *doc, const char *key, double amount, bool whole);
 
 /* Sets doc[key] to the time now (ISO 8601, UTC, milliseconds). */
 void tk_job_stamp(json_t *doc, const char *key);

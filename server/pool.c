@@ -69,6 +69,8 @@ typedef struct job_run {
                                 run's frame of its first step is stored) */
     long last_step;          /* the last step reported, -1 before */
     double last_flush;
+    bool rebase;             /* the store paused the run: it goes on in another (rebase) */
+    double clock;            /* the run's seconds when the store paused it */
     tk_invariants input_type; /* the type of the job's input */
     tk_invariants refused;    /* that of a stored curve the engine refused */
 } job_run;
@@ -215,6 +217,42 @@ static void lose(tk_pool *p, slot *sl)
     pthread_mutex_unlock(&p->lock);
 }
 
+/* The pending frames after the first `fit` are refused (beyond the bytes
+ * the job's owner may store): dropped, and counted in the document. */
+static void refuse(job_run *jr, size_t fit)
+{
+    size_t n = jr->npending - fit;
+    while (jr->npending > fit)
+        drop_frame(jr);
+    /* the step reported again at a resume takes no stored frame's place */
+    jr->frame_after = fit ? jr->pending[fit - 1].step : -1;
+    pthread_mutex_lock(&jr->pool->lock);
+    tk_job_add(jr->slot->doc, "frames_refused", (double)n, true);
+    jr->slot->frames = jr->stored + jr->npending;
+    pthread_mutex_unlock(&jr->pool->lock);
+}
+
+/* Writes the job as it stands with the parts given, its pending frames
+ * while they fit in its owner's bytes: those that do not are refused,
+ * and the document saying so written in their place. */
+static int put(job_run *jr, char *const *parts, const json_t *end, tk_error *err)
+{
+    size_t fit = 0;
+    int rc;
+    do {
+        pthread_mutex_lock(&jr->pool->lock);
+        json_t *doc = current(jr->slot);
+        pthread_mutex_unlock(&jr->pool->lock);
+        json_object_update(doc, (json_t *)end);
+        rc = tk_store_put_within(jr->pool->store, doc, (const char *const *)parts, jr->pending,
+                                 jr->stored, jr->npending, jr->pool->cfg.owner_bytes, &fit, err);
+        json_decref(doc);
+        if (rc == TK_ELIMIT)
+            refuse(jr, fit);
+    } while (rc == TK_ELIMIT);
+    return rc;
+}
+
 /* Writes the job's document, curve, contacts, history, resume point and
  * new frames in one transaction (NULL run: the document alone).  `end`
  * (or NULL) holds the fields of the job's end: they are written, and
@@ -244,12 +282,9 @@ static int flush(job_run *jr, const json_t *end, tk_error *err)
     pthread_mutex_lock(&jr->pool->lock);
     if (type)
         json_object_set_new(jr->slot->doc, "invariants", type);
-    json_t *doc = current(jr->slot);
     pthread_mutex_unlock(&jr->pool->lock);
-    json_object_update(doc, (json_t *)end);
     if (!rc)
-        rc = tk_store_put(jr->pool->store, doc, (const char *const *)parts, jr->pending,
-                          jr->stored, jr->npending, err);
+        rc = put(jr, parts, end, err);
     if (!rc) {
         jr->stored += jr->npending;
         while (jr->npending)
@@ -257,7 +292,6 @@ static int flush(job_run *jr, const json_t *end, tk_error *err)
     } else if (rc == TK_ENOTFOUND) {
         lose(jr->pool, jr->slot);
     }
-    json_decref(doc);
     for (int k = 0; k < TK_PARTS; k++)
         free(parts[k]);
     return rc;
@@ -276,11 +310,15 @@ static bool letting_go(job_run *jr, bool ended)
 /* Writes the job, pausing while the store refuses (see pool.h); `end` as
  * for flush (NULL while it runs).  TK_OK once written; TK_ENOTFOUND when
  * it is held elsewhere now; the store's failure when the pool halts or
- * the job is cancelled before a write succeeds. */
+ * the job is cancelled before a write succeeds.  The pause, from the
+ * first try (a lost server can take seconds to refuse), is added to the
+ * job's paused_seconds, and a running job goes on in a run whose clock
+ * leaves it out (rebase). */
 static int store_job(job_run *jr, const json_t *end)
 {
     tk_error err;
     bool paused = false, ended = end != NULL;
+    double t0 = seconds_now(), clock = jr->slot->latest.seconds; /* only this thread writes it */
     int rc;
     while ((rc = flush(jr, end, &err)) != TK_OK && !letting_go(jr, ended)) {
         pthread_mutex_lock(&jr->pool->lock);
@@ -292,9 +330,15 @@ static int store_job(job_run *jr, const json_t *end)
         nanosleep(&(struct timespec){1, 0}, NULL);
     }
     pthread_mutex_lock(&jr->pool->lock);
-    if (paused)
+    if (paused) {
         json_object_set_new(jr->slot->doc, "error", json_null());
+        tk_job_add(jr->slot->doc, "paused_seconds", seconds_now() - t0, false);
+    }
     pthread_mutex_unlock(&jr->pool->lock);
+    if (paused && !ended && !jr->rebase) {
+        jr->rebase = true;
+        jr->clock = clock;
+    }
     if (paused && !letting_go(jr, ended))
         flush(jr, end, &err); /* without the pause's message */
     return rc;
@@ -318,9 +362,49 @@ static int on_step(const tk_step_report *r, void *user)
     if (!go && seconds_now() - jr->last_flush >= p->cfg.flush_seconds) {
         store_job(jr, NULL);
         jr->last_flush = seconds_now();
-        go = letting_go(jr, false); /* a paused store may have waited through either */
+        go = letting_go(jr, false) || jr->rebase; /* a paused store may have waited through either */
     }
     return go;
+}
+
+/* The engine's clock runs from a run's start, a pause of the store
+ * included; a job's time budget is for work.  So after a pause the run
+ * goes on in a new one resumed from it (tk_run_resume, as after a
+ * restart, its clock at its latest step's): the same curve, schedule,
+ * escapes and best curve; the history before the resume kept here. */
+static int rebase(job_run *jr, tk_error *err)
+{
+    tk_resume at;
+    tk_step_report report;
+    tk_run_resume_point(jr->run, &at);
+    /* its clock when the pause began: the stop that ended it (which puts
+     * back the escapes' best curve, as a stop before a restart does) may
+     * have measured the curve again since */
+    at.seconds = fmin(at.seconds, jr->clock);
+    const tk_curve *best = tk_run_best(jr->run, &report);
+    char *text = history_text(jr);
+    json_t *before = text ? history_before(text, at.step) : NULL;
+    free(text);
+    tk_run *run = NULL;
+    int rc = !before ? tk_error_set(err, TK_ENOMEM, "out of memory")
+                     : tk_run_resume(tk_run_curve(jr->run), tk_run_options(jr->run), &at, best,
+                                     best ? &report : NULL, &jr->input_type, &run, err);
+    jr->rebase = false;
+    if (rc) {
+        json_decref(before);
+        return rc;
+    }
+    json_decref(jr->before);
+    jr->before = before;
+    tk_run_set_progress(run, on_step, jr);
+    pthread_mutex_lock(&jr->pool->lock);
+    tk_run *old = jr->run;
+    jr->run = jr->slot->run = run;
+    if (jr->slot->cancel || jr->slot->lost || jr->pool->stopping)
+        tk_run_cancel(run);
+    pthread_mutex_unlock(&jr->pool->lock);
+    tk_run_free(&old);
+    return TK_OK;
 }
 
 /* A line of the pool's log: the time (UTC, milliseconds), the job, what
@@ -465,7 +549,11 @@ static void run_job(slot *sl, int64_t id)
         on_step(tk_run_latest(jr.run), &jr);
         store_job(&jr, NULL);
         tk_run_set_progress(jr.run, on_step, &jr);
-        rc = tk_run_until(jr.run, &why, &err);
+        do { /* in a new run after each pause of the store (rebase) */
+            rc = jr.rebase ? rebase(&jr, &err) : TK_OK;
+            if (!rc)
+                rc = tk_run_until(jr.run, &why, &err);
+        } while (!rc && jr.rebase && !letting_go(&jr, false));
     }
     pthread_mutex_lock(&p->lock);
     sl->run = NULL;

@@ -1,15 +1,21 @@
 /* tightknot service: the job queue and the worker pool.
  *
  * The contract:
- * - Ordering.  The store is the queue: a free worker claims the oldest
- *   queued job (tk_store_claim), so jobs start in the order they came.
- *   tk_pool_submit stores a job and wakes a worker; workers that find
- *   nothing look again every second.
+ * - Ordering.  The store is the queue: a free worker claims the queued
+ *   job of the earliest turn (tk_store_claim).  Owners (token names) take
+ *   turns, round robin: a job's turn is one past its owner's latest job
+ *   waiting or running, or past the newest running job's when it has
+ *   none; so one owner's many queued jobs delay another's next job by
+ *   one or two of theirs, not all, and an owner's own jobs start in the
+ *   order they came.  tk_pool_submit stores a job and wakes a worker;
+ *   workers that find nothing look again every second.
  * - Running.  A worker runs the engine with the job's options exactly as
  *   `tightknot tighten` would (its whole schedule), keeps the job's
  *   document current at every step (tk_pool_live reads it) and writes it,
  *   with its curve, contacts, history, resume point and new frames, every
- *   flush_seconds and at the end, in one transaction.  A start the engine
+ *   flush_seconds and at the end, in one transaction.  Frames are stored
+ *   only while the owner's stored bytes stay within owner_bytes; the
+ *   others are refused and counted (frames_refused).  A start the engine
  *   refuses ends the job `failed` with the engine's message.
  * - Cancellation.  A queued job is cancelled in the store at once; a
  *   running one stops within a step and is stored `cancelled`: at once
@@ -28,6 +34,9 @@
  * - Store failures.  When a write fails (a full disk) the job pauses: its
  *   document's error says why and the write is retried every second until
  *   it succeeds or the pool halts (the job then resumes at the next start).
+ *   The pause is counted in paused_seconds and not spent of the time
+ *   budget: the run goes on in a new one resumed from it, as after a
+ *   restart, its clock where the pause began.
  * - Locks.  One mutex guards the workers' slots; no store call and no
  *   engine step is made while it is held, so a request never waits for a
  *   worker longer than a copy of a document.
@@ -46,7 +55,8 @@ typedef struct tk_pool_config {
     tk_priority priority; /* idle: workers use only CPU nothing else wants */
     size_t queue_limit;   /* queued jobs beyond which submissions are refused */
     size_t per_owner;     /* queued and running jobs a token's name may have (0: any) */
-    size_t owner_bytes;   /* bytes a token's name may have stored to submit (0: any) */
+    size_t owner_bytes;   /* bytes a token's name may have stored to submit, and with its
+                             frames (0: any) */
     size_t max_vertices;  /* a run's vertex limit, after re-resolution */
     double flush_seconds; /* how often a running job is written */
     size_t history;       /* history entries kept per job (thinned beyond) */

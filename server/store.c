@@ -45,6 +45,7 @@ struct tk_store {
     bool pg; /* PostgreSQL: shared with other daemons */
     double lease;
     char *where;
+    char label[200]; /* where, as messages name it: never a password */
     char holder[96];
     pthread_mutex_t lock; /* guards what follows; never held over a statement */
     void *idle[IDLE_MAX];
@@ -65,7 +66,8 @@ struct tk_store {
 static const char *const schema[2] = {
     "CREATE TABLE IF NOT EXISTS jobs (id INTEGER PRIMARY KEY AUTOINCREMENT,"
     " state TEXT NOT NULL, doc TEXT NOT NULL, input TEXT NOT NULL, curve TEXT, contacts TEXT,"
-    " history TEXT, resume TEXT, holder TEXT, cancel INTEGER NOT NULL DEFAULT 0);"
+    " history TEXT, resume TEXT, holder TEXT, cancel INTEGER NOT NULL DEFAULT 0,"
+    " turn INTEGER NOT NULL DEFAULT 0);"
     "CREATE INDEX IF NOT EXISTS jobs_by_state ON jobs (state, id);"
     "CREATE TABLE IF NOT EXISTS frames (job INTEGER NOT NULL REFERENCES jobs (id) ON DELETE"
     " CASCADE, seq INTEGER NOT NULL, step INTEGER NOT NULL, xyz BLOB NOT NULL, layout TEXT,"
@@ -75,7 +77,9 @@ static const char *const schema[2] = {
     "CREATE TABLE IF NOT EXISTS jobs (id bigserial PRIMARY KEY, state text NOT NULL,"
     " doc json NOT NULL, input bytea NOT NULL, curve bytea, contacts bytea, history bytea,"
     " resume bytea, holder text, lease timestamptz, cancel boolean NOT NULL DEFAULT false);"
+    "ALTER TABLE jobs ADD COLUMN IF NOT EXISTS turn bigint NOT NULL DEFAULT 0;"
     "CREATE INDEX IF NOT EXISTS jobs_by_state ON jobs (state, id);"
+    "CREATE INDEX IF NOT EXISTS jobs_by_turn ON jobs (state, turn, id);"
     "CREATE TABLE IF NOT EXISTS frames (job bigint NOT NULL REFERENCES jobs (id) ON DELETE"
     " CASCADE, seq bigint NOT NULL, step bigint NOT NULL, xyz bytea NOT NULL, layout text,"
     " PRIMARY KEY (job, seq));"
@@ -100,22 +104,37 @@ static const char upgrade[] =
     " input, curve, contacts, history, resume FROM jobs;"
     "DROP TABLE jobs; ALTER TABLE jobs_doc RENAME TO jobs; COMMIT;";
 
+/* The bytes stored for owner P's jobs, frames included (DOC and
+ * B(column) the sizes in bytes). */
+#define OWNER_BYTES(DOC, B, P)                                                                  \
+    "SELECT coalesce(sum(" DOC " + " B("input") " + " B("curve") " + " B("contacts") " + "      \
+    B("history") " + " B("resume") " + (SELECT coalesce(sum(length(xyz)), 0) FROM frames"       \
+    " WHERE job = jobs.id)), 0) FROM jobs WHERE doc->>'owner' = " P
+#define SQ_BYTES(c) "coalesce(length(CAST(" c " AS BLOB)), 0)"
+#define PG_BYTES(c) "coalesce(octet_length(" c "), 0)"
+#define SQ_OWNER_BYTES(P) OWNER_BYTES(SQ_BYTES("doc"), SQ_BYTES, P)
+#define PG_OWNER_BYTES(P) OWNER_BYTES("octet_length(doc::text)", PG_BYTES, P)
+/* (bigint: PostgreSQL's sum of bigints is numeric, which vquery does not read) */
+static const char *const owner_bytes_sql[2] = {"SELECT CAST((" SQ_OWNER_BYTES("$1") ") AS bigint)",
+                                               "SELECT CAST((" PG_OWNER_BYTES("$1") ") AS bigint)"};
+
 /* The limits and the insert in one statement: two requests cannot both
  * take the last place ($1 doc, $2 input, $3 queue, $4 owner, $5 its
- * jobs, $6 its bytes; DOC and B(column) the sizes in bytes). */
-#define ADD(DOC, B)                                                                             \
-    "INSERT INTO jobs (state, doc, input) SELECT 'queued', $1, $2"                              \
+ * jobs, $6 its bytes).  The job's turn in the queue is one past the
+ * latest of its owner's jobs waiting or running, or past the newest
+ * running job's when it has none: each owner's k-th waiting job has the
+ * k-th turn from now, so owners take turns (round robin) however many
+ * jobs one of them queues.  MAX and SAME are the dialects' words. */
+#define ADD(BYTES, MAX, SAME)                                                                   \
+    "INSERT INTO jobs (state, doc, input, turn) SELECT 'queued', $1, $2, 1 + " MAX "((SELECT"   \
+    " coalesce(max(turn), 0) FROM jobs WHERE state = 'running'), (SELECT coalesce(max(turn), 0)" \
+    " FROM jobs WHERE state IN ('queued', 'running') AND doc->>'owner' " SAME " $4))"           \
     " WHERE (SELECT count(*) FROM jobs WHERE state = 'queued') < $3"                            \
     " AND ($4 IS NULL OR $5 = 0 OR (SELECT count(*) FROM jobs WHERE state IN ('queued',"         \
     " 'running') AND doc->>'owner' = $4) < $5)"                                                 \
-    " AND ($4 IS NULL OR $6 = 0 OR (SELECT coalesce(sum(" DOC " + " B("input") " + " B("curve") \
-    " + " B("contacts") " + " B("history") " + " B("resume") " + (SELECT"                      \
-    " coalesce(sum(length(xyz)), 0) FROM frames WHERE job = jobs.id)), 0) FROM jobs"           \
-    " WHERE doc->>'owner' = $4) < $6) RETURNING id"
-#define SQ_BYTES(c) "coalesce(length(CAST(" c " AS BLOB)), 0)"
-#define PG_BYTES(c) "coalesce(octet_length(" c "), 0)"
-static const char *const add_sql[2] = {ADD(SQ_BYTES("doc"), SQ_BYTES),
-                                       ADD("octet_length(doc::text)", PG_BYTES)};
+    " AND ($4 IS NULL OR $6 = 0 OR (" BYTES ") < $6) RETURNING id"
+static const char *const add_sql[2] = {ADD(SQ_OWNER_BYTES("$4"), "max", "IS"),
+                                       ADD(PG_OWNER_BYTES("$4"), "greatest", "IS NOT DISTINCT FROM")};
 
 /* A state other than running lets go of the job (on PostgreSQL, running
  * renews its lease: $10 seconds). */
@@ -140,15 +159,16 @@ static const char *const cancel_sql[2] = {
 static const char *const requeue_sql[2] = {
     "UPDATE jobs SET state = 'queued', holder = NULL WHERE state = 'running'", NULL};
 
-/* On PostgreSQL the claim locks the row in the statement that makes it
- * ours, skipping rows another daemon is claiming or writing, and takes a
- * job whose lease ran out as well as a queued one. */
+/* The claim takes the job of the earliest turn (ADD), the oldest of
+ * equal turns.  On PostgreSQL it locks the row in the statement that
+ * makes it ours, skipping rows another daemon is claiming or writing,
+ * and takes a job whose lease ran out as well as a queued one. */
 static const char *const claim_sql[2] = {
-    "UPDATE jobs SET state = 'running', holder = $1 WHERE id = (SELECT min(id) FROM jobs"
-    " WHERE state = 'queued') RETURNING id",
+    "UPDATE jobs SET state = 'running', holder = $1 WHERE id = (SELECT id FROM jobs"
+    " WHERE state = 'queued' ORDER BY turn, id LIMIT 1) RETURNING id",
     "UPDATE jobs SET state = 'running', holder = $1, lease = now() + make_interval(secs => $2)"
     " WHERE id = (SELECT id FROM jobs WHERE state = 'queued' OR (state = 'running' AND lease"
-    " < now()) ORDER BY id LIMIT 1 FOR UPDATE SKIP LOCKED) RETURNING id"};
+    " < now()) ORDER BY turn, id LIMIT 1 FOR UPDATE SKIP LOCKED) RETURNING id"};
 
 /* SQLite: the holder is always this store while it runs, and only
  * cancellation is news. */
@@ -249,7 +269,7 @@ static void *connect_to(const tk_store *s, int flags, tk_error *err)
             return c;
         }
         m = c ? PQerrorMessage(c) : m;
-        tk_error_set(err, TK_EIO, "cannot reach the job store %s: %.*s", s->where,
+        tk_error_set(err, TK_EIO, "cannot reach the job store %s: %.*s", s->label,
                      (int)strcspn(m, "\n"), m);
         PQfinish(c);
         return NULL;
@@ -266,7 +286,7 @@ static void *connect_to(const tk_store *s, int flags, tk_error *err)
         sqlite3_busy_timeout(db, 10000);
         return db;
     }
-    tk_error_set(err, TK_EIO, "cannot set up the job store %s: %s", s->where,
+    tk_error_set(err, TK_EIO, "cannot set up the job store %s: %s", s->label,
                  db ? sqlite3_errmsg(db) : sqlite3_errstr(rc));
     sqlite3_close_v2(db);
     return NULL;
@@ -477,8 +497,38 @@ static bool sqlite_setup(tk_store *s, sqlite3 *db)
         /* a store from before holders (an error where they are there) */
         script(s, db, "ALTER TABLE jobs ADD COLUMN holder TEXT");
         script(s, db, "ALTER TABLE jobs ADD COLUMN cancel INTEGER NOT NULL DEFAULT 0");
+        script(s, db, "ALTER TABLE jobs ADD COLUMN turn INTEGER NOT NULL DEFAULT 0");
+        ok = script(s, db, "CREATE INDEX IF NOT EXISTS jobs_by_turn ON jobs (state, turn, id)");
     }
     return ok;
+}
+
+/* The store as messages name it.  A PostgreSQL URI may carry a user's
+ * password (in its authority or its query), and messages reach clients
+ * (health, problems) and logs: so only its host, port and database. */
+static void label_store(tk_store *s)
+{
+    if (!s->pg) {
+        snprintf(s->label, sizeof s->label, "%.190s", s->where);
+        return;
+    }
+    PQconninfoOption *opts = PQconninfoParse(s->where, NULL);
+    const char *host = NULL, *port = NULL, *db = NULL;
+    for (PQconninfoOption *o = opts; o && o->keyword; o++) {
+        const char **slot = !strcmp(o->keyword, "host")     ? &host
+                            : !strcmp(o->keyword, "port")   ? &port
+                            : !strcmp(o->keyword, "dbname") ? &db
+                                                            : NULL;
+        if (slot && o->val && o->val[0])
+            *slot = o->val;
+    }
+    if (opts)
+        snprintf(s->label, sizeof s->label, "PostgreSQL database '%.60s' on %.60s%s%.8s",
+                 db ? db : "(default)", host ? host : "localhost", port ? ":" : "",
+                 port ? port : "");
+    else
+        snprintf(s->label, sizeof s->label, "PostgreSQL (its URI does not parse)");
+    PQconninfoFree(opts);
 }
 
 int tk_store_open(const char *where, double lease, tk_store **out, tk_error *err)
@@ -490,6 +540,7 @@ int tk_store_open(const char *where, double lease, tk_store **out, tk_error *err
         return tk_error_set(err, TK_ENOMEM, "out of memory");
     }
     s->pg = !strncmp(where, "postgresql://", 13) || !strncmp(where, "postgres://", 11);
+    label_store(s);
     s->lease = lease;
     pthread_mutex_init(&s->lock, NULL);
     char host[64] = "host";
@@ -506,7 +557,7 @@ int tk_store_open(const char *where, double lease, tk_store **out, tk_error *err
     }
     if (c) {
         const char *m = s->pg ? PQerrorMessage(c) : sqlite3_errmsg(c);
-        tk_error_set(err, TK_EIO, "cannot set up the job store %s: %.200s", where, m);
+        tk_error_set(err, TK_EIO, "cannot set up the job store %s: %.200s", s->label, m);
         give(s, c); /* rolls back a part done */
     }
     tk_store_close(&s);
@@ -588,14 +639,27 @@ int tk_store_add(tk_store *s, json_t *doc, const char *input, const tk_store_lim
 int tk_store_put(tk_store *s, const json_t *doc, const char *const *parts,
                  const tk_frame *frames, size_t first, size_t nframes, tk_error *err)
 {
+    return tk_store_put_within(s, doc, parts, frames, first, nframes, 0, NULL, err);
+}
+
+int tk_store_put_within(tk_store *s, const json_t *doc, const char *const *parts,
+                        const tk_frame *frames, size_t first, size_t nframes, size_t owner_bytes,
+                        size_t *fit, tk_error *err)
+{
     void *c = take(s, err);
     if (!c)
         return written(s, TK_EIO, err);
     int64_t id = tk_job_id(doc);
     char *text = tk_json_dump(doc, false);
     const char *const *p = parts ? parts : (const char *const[TK_PARTS]){NULL};
+    const char *owner = json_string_value(json_object_get(doc, "owner"));
+    bool limited = owner && owner_bytes && nframes;
     rows r = {0};
+    /* a limited write holds the submissions' lock (PostgreSQL; SQLite's
+     * writers take turns anyway): its count of the owner's bytes stays
+     * true until it commits */
     bool ok = text && script(s, c, begin_sql[s->pg]) &&
+              (!limited || script(s, c, lock_sql[s->pg])) &&
               query(s, c, &r, put_sql[s->pg], "tjxxxxxitd", tk_job_states[tk_job_state_in(doc)],
                     text, p[0], p[1], p[2], p[3], p[4], id, s->holder, s->lease);
     int rc = ok && r.changed != 1
@@ -605,11 +669,26 @@ int tk_store_put(tk_store *s, const json_t *doc, const char *const *parts,
     ok = ok && !rc &&
          query(s, c, NULL, "DELETE FROM frames WHERE job = $1 AND seq >= $2", "ii", id,
                (int64_t)first);
-    for (size_t i = 0; ok && i < nframes; i++)
+    /* the frames that fit beside all else the owner has stored, this
+     * document and these parts included; the write is undone when not
+     * all of them do, for the caller to write its count again */
+    size_t n = 0;
+    if (ok && !rc && limited && (ok = query(s, c, &r, owner_bytes_sql[s->pg], "t", owner))) {
+        int64_t room = (int64_t)owner_bytes - int_at(&r, 0, 0), size;
+        while (n < nframes && (size = (int64_t)(frames[n].count * sizeof(double))) <= room)
+            n++, room -= size;
+        rows_free(&r);
+    }
+    if (ok && !rc && limited && n < nframes) {
+        *fit = n;
+        rc = tk_error_set(err, TK_ELIMIT, "'%.64s' has stored as many bytes as a name may "
+                          "(--bytes-per-name): %zu of %zu frames fit", owner, n, nframes);
+    }
+    for (size_t i = 0; ok && !rc && i < nframes; i++)
         ok = query(s, c, NULL, "INSERT INTO frames VALUES ($1, $2, $3, $4, $5)", "iiibt", id,
                    (int64_t)(first + i), (int64_t)frames[i].step, (const char *)frames[i].xyz,
                    frames[i].count * sizeof(double), frames[i].layout);
-    ok = ok && script(s, c, "COMMIT");
+    ok = ok && !rc && script(s, c, "COMMIT");
     if (!ok && !rc)
         rc = failed(s, c, err, "writing a job");
     free(text);

@@ -1,7 +1,8 @@
 /* tightknot service: the job store, behind a narrow interface.
  *
  * A job is a row of a few fixed columns: its id, its state (the queue is
- * the store: claiming takes the oldest queued job), its document
+ * the store: claiming takes the queued job of the earliest turn, see
+ * tk_store_claim), its document
  * (job.h), its large parts, who holds it while it runs, and its frames in
  * a table of their own.  Two backends, one SQL (store.c):
  * - SQLite: one file in WAL mode for one daemon, each thread on a
@@ -75,6 +76,14 @@ int tk_store_add(tk_store *s, json_t *doc, const char *input, const tk_store_lim
 int tk_store_put(tk_store *s, const json_t *doc, const char *const *parts,
                  const tk_frame *frames, size_t first, size_t nframes, tk_error *err);
 
+/* tk_store_put, its frames only while the bytes stored for the
+ * document's owner stay within owner_bytes (0: any), counted in the same
+ * transaction with the document and parts written: when not all fit,
+ * nothing is written, *fit says how many would, and TK_ELIMIT. */
+int tk_store_put_within(tk_store *s, const json_t *doc, const char *const *parts,
+                        const tk_frame *frames, size_t first, size_t nframes, size_t owner_bytes,
+                        size_t *fit, tk_error *err);
+
 /* The job's document (TK_ENOTFOUND when there is none).  On a shared
  * store it may be one read up to half a second ago, unless a write went
  * through this store since. */
@@ -88,8 +97,13 @@ int tk_store_part(tk_store *s, int64_t id, tk_part part, char **text, size_t *le
 int tk_store_list(tk_store *s, int state, const char *owner, size_t offset, size_t limit,
                   json_t **docs, size_t *total, tk_error *err);
 
-/* The oldest queued job (PostgreSQL: or running with its lease run out)
- * becomes running, held here: its id; TK_ENOTFOUND when none. */
+/* The queued job of the earliest turn, the oldest of equal turns
+ * (PostgreSQL: or a running one whose lease ran out) becomes running,
+ * held here: its id; TK_ENOTFOUND when none.  A job's turn, given when it
+ * is added, is one past its owner's latest waiting or running job's, or
+ * past the newest running job's when the owner has none: owners take
+ * turns, so one owner's many queued jobs do not keep another's waiting
+ * behind all of them. */
 int tk_store_claim(tk_store *s, int64_t *id, tk_error *err);
 
 /* Keeps a running job held here (PostgreSQL: its lease starts again);

@@ -31,7 +31,8 @@ static const tk_field fields[] = {
         "429 (0: any number)"),
     ROW(pool.owner_bytes, bytes_per_name, SIZE, 1 << 30, 0, 0x1p50,
         "with --tokens: bytes stored for a name's jobs (inputs, curves, histories, frames) "
-        "beyond which its submissions get 429 until it deletes finished jobs (0: any number)"),
+        "beyond which its submissions get 429 until it deletes finished jobs, and its running "
+        "jobs' frames are refused (0: any number)"),
     ROW(api.max_vertices, max_vertices, SIZE, 200000, 3, TK_RUN_MAX_VERTICES,
         "largest knot accepted, after re-resolution"),
     ROW(api.max_body, max_body, SIZE, 16 << 20, 64, 0x1p32, "largest request body in bytes"),
