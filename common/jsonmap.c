@@ -108,6 +108,52 @@ json_t *tk_json_escapes(const tk_escape *e, size_t count)
     return list;
 }
 
+static int by_value(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Why TK_BASIN_SAME is 1e-4: re-posed copies of one start, and escapes
+ * back into the basin they left, end within 2e-5 of each other at
+ * resolution 5, while the distinct basins seen on the catalogue are
+ * 1.6e-3 and more apart. */
+json_t *tk_json_basins(const tk_escape *e, size_t count, double final)
+{
+    double *seen = malloc((count + 1) * sizeof *seen);
+    if (!seen)
+        return NULL;
+    size_t n = 0;
+    for (size_t k = 0; k < count; k++) {
+        if (e[k].explored)
+            continue;
+        if (n == 0 && isfinite(e[k].from))
+            seen[n++] = e[k].from;
+        if (isfinite(e[k].reached))
+            seen[n++] = e[k].reached;
+    }
+    if (n == 0 && isfinite(final))
+        seen[n++] = final;
+    qsort(seen, n, sizeof *seen, by_value);
+    json_t *basins = json_array();
+    size_t best = 0;
+    for (size_t k = 0; k < n;) {
+        size_t j = k + 1;
+        while (j < n && seen[j] - seen[k] <= TK_BASIN_SAME * seen[k])
+            j++;
+        json_array_append_new(basins, json_pack("{s:o, s:I}", "ropelength",
+                                                tk_json_number(seen[k]), "reached",
+                                                (json_int_t)(j - k)));
+        if (k == 0)
+            best = j - k;
+        k = j;
+    }
+    free(seen);
+    return json_pack("{s:o, s:I, s:o}", "basins", basins, "best_reached", (json_int_t)best,
+                     "note", best == 1 ? json_string("found once: run longer or with more seeds")
+                                       : json_null());
+}
+
 /* Arclength at the start of every edge, components laid end to end:
  * start[e] for global edge e, plus each component's start in comp_start. */
 static double *edge_starts(const tk_curve *c, double *comp_start)

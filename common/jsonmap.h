@@ -47,6 +47,19 @@ json_t *tk_json_options(const tk_options *o);
  * "reached" (null while under way), "improved"}]. */
 json_t *tk_json_escapes(const tk_escape *e, size_t count);
 
+/* How sure a run is of its result: the distinct basins (critical
+ * configurations) its tightenings on the final polygon reached.  Each
+ * tightening there is one sighting: the first (the best value when the
+ * first try on the final polygon began) and each try's `reached`;
+ * explored tries, judged on the coarsest polygon only, and tries given up
+ * are none.  Sightings within TK_BASIN_SAME (relative) of each other are
+ * one basin.  `final` is the run's result (a sighting too when no try was
+ * made).  {"basins": [{"ropelength", "reached"}] lowest first,
+ * "best_reached": how many sightings the lowest basin had, "note": null,
+ * or "found once: run longer or with more seeds" when that is 1}. */
+#define TK_BASIN_SAME 1e-4
+json_t *tk_json_basins(const tk_escape *e, size_t count, double final);
+
 /* The contacts of curve c:
  *   {"components": [{"vertices", "closed", "length", "start"}],
  *    "struts": [{"edges": [[comp, edge], [comp, edge]], "s", "t", "p", "q",

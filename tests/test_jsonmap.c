@@ -229,6 +229,45 @@ START_TEST(unknown_components_are_null)
 }
 END_TEST
 
+/* The basins a run reached, counted by hand: the first tightening on the
+ * final polygon (the first counted try's `from`), then each try's end;
+ * explored tries and tries given up are no sighting; values within
+ * TK_BASIN_SAME are one basin. */
+START_TEST(basins_count_the_sightings)
+{
+    const double n = NAN;
+    /* step, from, amplitude, coarse, reached, improved, explored */
+    tk_escape e[] = {{10, 72.0, 1.0, 90.0, n, false, true},        /* explored: none */
+                     {20, 71.128, 1.0, n, 71.1281, false, false},  /* 71.128 twice */
+                     {30, 71.128, 0.7, n, 71.001, true, false},    /* a lower basin */
+                     {40, 71.001, 0.5, n, n, false, false},        /* given up: none */
+                     {50, 71.001, 0.3, n, 71.0015, false, false}}; /* 71.001 again */
+    json_t *b = tk_json_basins(e, 5, 71.0008);
+    json_t *list = json_object_get(b, "basins");
+    ck_assert_uint_eq(json_array_size(list), 2);
+    ck_assert(json_real_value(json_object_get(json_array_get(list, 0), "ropelength")) == 71.001);
+    ck_assert_int_eq(json_integer_value(json_object_get(json_array_get(list, 0), "reached")), 2);
+    ck_assert(json_real_value(json_object_get(json_array_get(list, 1), "ropelength")) == 71.128);
+    ck_assert_int_eq(json_integer_value(json_object_get(json_array_get(list, 1), "reached")), 2);
+    ck_assert_int_eq(json_integer_value(json_object_get(b, "best_reached")), 2);
+    ck_assert(json_is_null(json_object_get(b, "note")));
+    json_decref(b);
+    /* the lowest once: flagged */
+    b = tk_json_basins(e, 3, 71.0008);
+    ck_assert_int_eq(json_integer_value(json_object_get(b, "best_reached")), 1);
+    ck_assert_str_eq(json_string_value(json_object_get(b, "note")),
+                     "found once: run longer or with more seeds");
+    json_decref(b);
+    /* no try on the final polygon: the result alone, once */
+    b = tk_json_basins(e, 1, 42.1);
+    list = json_object_get(b, "basins");
+    ck_assert_uint_eq(json_array_size(list), 1);
+    ck_assert(json_real_value(json_object_get(json_array_get(list, 0), "ropelength")) == 42.1);
+    ck_assert_int_eq(json_integer_value(json_object_get(b, "best_reached")), 1);
+    json_decref(b);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("jsonmap");
@@ -238,6 +277,7 @@ int main(void)
     tcase_add_test(tc, numbers_keep_every_bit_and_infinities_are_null);
     tcase_add_test(tc, invariants_of_known_knots_and_links);
     tcase_add_test(tc, unknown_components_are_null);
+    tcase_add_test(tc, basins_count_the_sightings);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);
 }

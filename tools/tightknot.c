@@ -235,7 +235,12 @@ static const char tighten_help_end[] =
     "                          from, amplitude, coarse, reached, improved,\n"
     "                          explored}], one per escape tried (explored: on\n"
     "                          the coarsest polygon alone, before the first\n"
-    "                          refinement), and recovery: {undone_steps,\n"
+    "                          refinement), basins: {basins: [{ropelength,\n"
+    "                          reached}], best_reached, note}, the distinct\n"
+    "                          results its tightenings on the final polygon\n"
+    "                          reached, lowest first, with how often (a\n"
+    "                          lowest reached once is noted: run longer or\n"
+    "                          with more seeds), and recovery: {undone_steps,\n"
     "                          rescales, largest_rescale, bent_corrections,\n"
     "                          length_steps, corrected_steps}, error\n"
     "                          recovery's last resorts and the steps judged\n"
@@ -853,6 +858,20 @@ static int write_struts_file(const char *path, const char *name, tk_run *run)
     return EXIT_OK;
 }
 
+/* The basins a run's tightenings reached (tk_json_basins), on a line. */
+static void print_basins(json_t *b)
+{
+    json_t *list = json_object_get(b, "basins"), *one;
+    size_t k;
+    printf("  basins reached on the final polygon:");
+    json_array_foreach(list, k, one)
+        printf("%s %.9g (%lld)", k ? "," : "", json_real_value(json_object_get(one, "ropelength")),
+               (long long)json_integer_value(json_object_get(one, "reached")));
+    const char *note = json_string_value(json_object_get(b, "note"));
+    printf("%s%s\n", note ? "; the lowest " : "", note ? note : "");
+    json_decref(b);
+}
+
 static int cmd_tighten(int argc, char **argv)
 {
     cli_args a;
@@ -943,6 +962,7 @@ static int cmd_tighten(int argc, char **argv)
         size_t ne = 0;
         const tk_escape *e = tk_run_escapes(run, &ne);
         json_object_set_new(o, "escapes", tk_json_escapes(e, ne));
+        json_object_set_new(o, "basins", tk_json_basins(e, ne, last->ropelength));
         tk_run_timing t;
         tk_run_timing_get(run, &t);
         json_object_set_new(o, "recovery",
@@ -997,6 +1017,7 @@ static int cmd_tighten(int argc, char **argv)
             else
                 printf("reached %.9g%s\n", e[k].reached, e[k].improved ? " (better)" : "");
         }
+        print_basins(tk_json_basins(e, ne, last->ropelength));
     }
 done:
     if (w.log && fclose(w.log) != 0) {
