@@ -2,6 +2,7 @@
 #include "job.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 #include <time.h>
 
@@ -78,14 +79,26 @@ void tk_job_add(json_t *doc, const char *key, double amount, bool whole)
 
 void tk_job_stamp(json_t *doc, const char *key)
 {
+    char now[32];
+    tk_time_iso(now);
+    json_object_set_new(doc, key, json_string(now));
+}
+
+void tk_time_iso(char out[32])
+{
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
     struct tm tm;
     gmtime_r(&ts.tv_sec, &tm);
-    char buf[96];
-    snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03ldZ", tm.tm_year + 1900,
-             tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, ts.tv_nsec / 1000000);
-    json_object_set_new(doc, key, json_string(buf));
+    size_t n = strftime(out, 32, "%Y-%m-%dT%H:%M:%S", &tm);
+    snprintf(out + n, 32 - n, ".%03ldZ", ts.tv_nsec / 1000000);
+}
+
+double tk_clock_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 size_t tk_job_thin(size_t i, size_t n, size_t keep)

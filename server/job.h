@@ -42,8 +42,14 @@ void tk_job_set_figures(json_t *doc, const tk_step_report *r, const tk_job_optio
 /* Adds amount to the count (whole) or number doc[key] (0 when absent). */
 void tk_job_add(json_t *doc, const char *key, double amount, bool whole);
 
-/* Sets doc[key] to the time now (ISO 8601, UTC, milliseconds). */
+/* Sets doc[key] to the time now (tk_time_iso). */
 void tk_job_stamp(json_t *doc, const char *key);
+
+/* The time now, ISO 8601, UTC, milliseconds: "2024-05-06T07:08:09.123Z". */
+void tk_time_iso(char out[32]);
+
+/* Seconds on the monotonic clock: for spans and deadlines. */
+double tk_clock_seconds(void);
 
 /* The index of the i-th of `keep` entries taken evenly from n (keep >= 2
  * takes the first and the last): how a history is thinned. */

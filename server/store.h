@@ -2,9 +2,10 @@
  *
  * A job is a row of a few fixed columns: its id, its state (the queue is
  * the store: claiming takes the queued job of the earliest turn, see
- * tk_store_claim), its document
- * (job.h), its large parts, who holds it while it runs, and its frames in
- * a table of their own.  Two backends, one SQL (store.c):
+ * tk_store_claim), its owner (indexed: a name's jobs are read without
+ * the others'), its document (job.h; the state and id are the columns'),
+ * its large parts, who holds it while it runs, and its frames in a table
+ * of their own.  Two backends (store_db.h), one SQL (store.c):
  * - SQLite: one file in WAL mode for one daemon, each thread on a
  *   connection of its own, so a reader never waits for a writer;
  * - PostgreSQL: one database shared by any number of daemons.
@@ -23,14 +24,16 @@
 
 #include "job.h"
 
-typedef enum tk_part {
-    TK_PART_INPUT,    /* the VECT as submitted */
-    TK_PART_CURVE,    /* the latest curve as VECT (NULL before the run) */
-    TK_PART_CONTACTS, /* struts and kinks (tk_json_contacts) */
-    TK_PART_HISTORY,  /* the decimated step figures, a JSON array */
-    TK_PART_RESUME,   /* {"at", "best", "best_report"}: where the run resumes */
-    TK_PARTS
-} tk_part;
+/* A job's large parts, each a column: X(ENUM, column, its parameter in
+ * the write of a job (store_db.h), the column's constraint) */
+#define TK_PART_COLUMNS(X)                                                                      \
+    X(INPUT, input, 3, " NOT NULL") /* the VECT as submitted */                                 \
+    X(CURVE, curve, 4, "")          /* the latest curve as VECT (NULL before the run) */        \
+    X(CONTACTS, contacts, 5, "")    /* struts and kinks (tk_json_contacts) */                   \
+    X(HISTORY, history, 6, "")      /* the decimated step figures, a JSON array */              \
+    X(RESUME, resume, 7, "")        /* {at, best, best_report}: where the run resumes */
+#define TK_PART_ENUM(E, col, n, what) TK_PART_##E,
+typedef enum tk_part { TK_PART_COLUMNS(TK_PART_ENUM) TK_PARTS } tk_part;
 
 /* A frame: its step, the curve's coordinates and its vertices per
  * component as a JSON array (NULL: those of the job's curve). */

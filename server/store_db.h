@@ -1,0 +1,115 @@
+/* tightknot service: the store's two backends (store_sqlite.c,
+ * store_pg.c) behind the table store.c speaks through.  A backend runs a
+ * statement with its parameters and hands back its rows as text; the
+ * operations, their SQL and the connections' reuse are store.c's. */
+#ifndef TK_SERVER_STORE_DB_H
+#define TK_SERVER_STORE_DB_H
+
+#include <stdbool.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "tk/error.h"
+
+#define MAX_PARAMS 10
+
+/* A result: n rows of ncol cells, each a NUL-terminated copy (NULL for a
+ * SQL null), and the rows a change touched. */
+typedef struct rows {
+    size_t n, ncol, changed;
+    char **cell;
+    size_t *len;
+} rows;
+
+void rows_free(rows *r);
+/* Sets cell j of the last row (j 0 begins a new one) to a copy of p;
+ * false when out of memory. */
+bool rows_add(rows *r, size_t j, const void *p, size_t len);
+const char *rows_cell(const rows *r, size_t i, size_t j);
+int64_t rows_int(const rows *r, size_t i, size_t j); /* 0 for a null */
+char *rows_steal(rows *r, size_t i, size_t j);       /* the cell, taken out of r */
+
+/* A statement's parameters $1.. by type: i int64, d double, t text (NULL:
+ * null), j JSON text, x text kept as bytes (bytea on PostgreSQL), b bytes
+ * (value and length). */
+typedef struct params {
+    int n;
+    char type[MAX_PARAMS];
+    const char *value[MAX_PARAMS];
+    int length[MAX_PARAMS];
+    int64_t ints[MAX_PARAMS];
+    double reals[MAX_PARAMS];
+    char number[MAX_PARAMS][32];
+} params;
+
+typedef struct backend {
+    /* A connection (create: the SQLite file may be made), or NULL with
+     * TK_EIO naming `label`. */
+    void *(*connect)(const char *where, const char *label, bool create, tk_error *err);
+    void (*disconnect)(void *c);
+    const char *(*error)(void *c);
+    /* Statements without parameters or results; whether they ran. */
+    bool (*script)(void *c, const char *sql);
+    /* One statement; its rows into *r.  Whether it ran. */
+    bool (*run)(void *c, rows *r, const char *sql, const params *p);
+    /* Rolls back what did not commit; whether c may be used again. */
+    bool (*release)(void *c);
+    /* Creates the tables, or brings a store of an earlier version up to
+     * date; whether it could. */
+    bool (*setup)(void *c);
+    /* `where` as messages name it (never a password). */
+    void (*label)(const char *where, char *out, size_t size);
+    /* Why the file system cannot take a write, into reason (NULL: no file). */
+    void (*room)(const char *where, char *reason, size_t size);
+    /* The dialect, where the two differ: the claim, the renewal, the
+     * requeue at start and the lock over submissions (NULL: none), and
+     * the statements built from store.c's shared text with the dialect's
+     * words. */
+    const char *claim, *renew, *requeue, *begin, *lock, *add, *put, *owner_bytes;
+} backend;
+
+/* Statements without parameters whose results are not needed (NULL:
+ * none for this backend); whether they ran. */
+bool db_script(const backend *db, void *c, const char *sql);
+/* Runs a statement (NULL: none for this backend) whose parameters $1,
+ * $2, ... are given by `types` (params; b takes a pointer and a size_t
+ * length).  Its rows go to *out when not NULL.  Whether it ran (the
+ * connection's error says why not). */
+bool db_query(const backend *db, void *c, rows *out, const char *sql, const char *types, ...);
+bool db_vquery(const backend *db, void *c, rows *out, const char *sql, const char *types,
+               va_list ap);
+
+const backend *tk_store_sqlite(void);
+const backend *tk_store_pg(void);
+
+/* The advisory lock that makes a submission's limits and insert one step
+ * across daemons (any number no other program on the database uses). */
+#define ADD_LOCK "7310519"
+
+/* The shared SQL's texts, with the dialect's words: B(column) a column's
+ * size in bytes (DOC_BYTES the document's), LEASE what a write of a running job sets besides.  The bytes stored for owner P's jobs, frames
+ * included; the limits and the insert in one statement ($1 doc, $2
+ * input, $3 queue, $4 owner, $5 its jobs, $6 its bytes: two requests
+ * cannot both take the last place).  A job's turn is one past the latest
+ * of its owner's jobs waiting or running, or past the newest running
+ * job's (store.h); no name is owner '' (the owner column's null). */
+#define SQL_PART_BYTES(E, col, n, sql) " + " B(#col)
+#define SQL_OWNER_BYTES(P)                                                                      \
+    "SELECT CAST(coalesce(sum(" DOC_BYTES TK_PART_COLUMNS(SQL_PART_BYTES) " + (SELECT"           \
+    " coalesce(sum(length(xyz)), 0) FROM frames WHERE job = jobs.id)), 0) AS bigint) FROM jobs" \
+    " WHERE owner = " P
+#define SQL_ADD                                                                                 \
+    "INSERT INTO jobs (state, doc, input, owner, turn) SELECT 'queued', $1, $2, coalesce($4,"   \
+    " ''), 1 + (SELECT coalesce(max(turn), 0) FROM jobs WHERE state = 'running' OR (owner ="     \
+    " coalesce($4, '') AND state = 'queued')) WHERE (SELECT count(*) FROM jobs WHERE state ="    \
+    " 'queued') < $3 AND ($4 IS NULL OR $5 = 0 OR (SELECT count(*) FROM jobs WHERE owner = $4"   \
+    " AND state IN ('queued', 'running')) < $5)"                                                \
+    " AND ($4 IS NULL OR $6 = 0 OR (" SQL_OWNER_BYTES("$4") ") < $6) RETURNING id"
+/* A state other than running lets go of the job. */
+#define SQL_PART_SET(E, col, n, sql) ", " #col " = coalesce($" #n ", " #col ")"
+#define SQL_PUT                                                                                 \
+    "UPDATE jobs SET state = $1, doc = $2" TK_PART_COLUMNS(SQL_PART_SET)                        \
+    ", holder = CASE $1 WHEN 'running' THEN holder END" LEASE " WHERE id = $8 AND holder = $9"
+
+#endif
