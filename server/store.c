@@ -14,41 +14,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/random.h>
-#include <unistd.h>
 
 #include "jsonmap.h"
 #include "store_db.h"
 
-#define IDLE_MAX 32 /* connections kept for reuse; more are opened while needed */
-/* On a shared store the documents last read are served again for a
- * moment: a daemon that runs nothing answers a crowd of pollers of a job
- * running elsewhere from memory, not with a query each (the job's own
- * daemon writes it only every 2 s anyway).  Any write through this store
- * drops them all, so a client sees its own DELETE at once. */
-#define RECENT_MAX 64   /* documents kept, one slot per id modulo this */
-#define RECENT_AGE 0.5  /* seconds a kept document is served again */
-
-struct tk_store {
-    const backend *db;
-    bool pg; /* PostgreSQL: shared with other daemons */
-    double lease;
-    char *where;
-    char label[200]; /* where, as messages name it: never a password */
-    char holder[96];
-    pthread_mutex_t lock; /* guards what follows; never held over a statement */
-    void *idle[IDLE_MAX];
-    size_t nidle;
-    char write_error[TK_ERROR_MESSAGE_SIZE]; /* the last write's failure, "" once one succeeds */
-    char damage[TK_ERROR_MESSAGE_SIZE];      /* the first damage a reader found */
-    uint64_t writes; /* writes through this store so far */
-    struct kept {
-        int64_t id;
-        uint64_t writes; /* the count when it was read: stale once another write came */
-        double at;       /* when it was read (monotonic seconds) */
-        json_t *doc;     /* never handed out: copies are */
-    } recent[RECENT_MAX];
-};
 
 #define MATCHING                                                                                \
     " FROM jobs WHERE ($1 IS NULL OR state = $1) AND ($2 IS NULL OR owner = $2)"
@@ -57,113 +26,6 @@ struct tk_store {
 static const char *const part_columns[TK_PARTS] = {TK_PART_COLUMNS(PART_NAME)};
 _Static_assert(TK_PARTS == 5, "tk_store_put passes the parts as $3..$7: name them there");
 
-/* ---- statements and connections ---- */
-
-/* The connection's last error, on one line, as TK_EIO. */
-static int failed(const tk_store *s, void *c, tk_error *err, const char *what)
-{
-    const char *m = s->db->error(c);
-    size_t n = strcspn(m, "\n");
-    return tk_error_set(err, TK_EIO, "job store: %s: %.*s", what, (int)n, n ? m : "no answer");
-}
-
-/* A connection for this call; the lock only guards the list. */
-static void *take(tk_store *s, tk_error *err)
-{
-    pthread_mutex_lock(&s->lock);
-    void *c = s->nidle ? s->idle[--s->nidle] : NULL;
-    pthread_mutex_unlock(&s->lock);
-    return c ? c : s->db->connect(s->where, s->label, false, err);
-}
-
-/* Back to the list, what did not commit rolled back, unless it broke (a
- * lost server). */
-static void give(tk_store *s, void *c)
-{
-    bool keep = s->db->release(c);
-    pthread_mutex_lock(&s->lock);
-    if (keep && s->nidle < IDLE_MAX) {
-        s->idle[s->nidle++] = c;
-        c = NULL;
-    }
-    pthread_mutex_unlock(&s->lock);
-    if (c)
-        s->db->disconnect(c);
-}
-
-/* Notes a write's outcome for health: a failure to reach or write the
- * store (TK_EIO, TK_ENOMEM) until the next write that succeeds; answers
- * about the job (busy, not found, not queued) are neither.  Returns rc. */
-static int written(tk_store *s, int rc, const tk_error *err)
-{
-    pthread_mutex_lock(&s->lock);
-    s->writes++;
-    if (rc == TK_OK || rc == TK_EIO || rc == TK_ENOMEM)
-        snprintf(s->write_error, sizeof s->write_error, "%s", rc ? err->message : "");
-    pthread_mutex_unlock(&s->lock);
-    return rc;
-}
-
-/* ---- opening ---- */
-
-int tk_store_open(const char *where, double lease, tk_store **out, tk_error *err)
-{
-    *out = NULL;
-    tk_store *s = calloc(1, sizeof *s);
-    if (!s || !(s->where = strdup(where))) {
-        free(s);
-        return tk_error_set(err, TK_ENOMEM, "out of memory");
-    }
-    s->pg = !strncmp(where, "postgresql://", 13) || !strncmp(where, "postgres://", 11);
-    s->db = s->pg ? tk_store_pg() : tk_store_sqlite();
-    s->db->label(where, s->label, sizeof s->label);
-    s->lease = lease;
-    pthread_mutex_init(&s->lock, NULL);
-    char host[64] = "host";
-    gethostname(host, sizeof host - 1);
-    unsigned long long nonce = 0;
-    if (getrandom(&nonce, sizeof nonce, 0) != (ssize_t)sizeof nonce)
-        nonce = (unsigned long long)(uintptr_t)s ^ (unsigned long long)getpid();
-    snprintf(s->holder, sizeof s->holder, "%.63s:%ld:%016llx", host, (long)getpid(), nonce);
-    void *c = s->db->connect(where, s->label, true, err);
-    if (c && s->db->setup(c)) {
-        s->idle[s->nidle++] = c;
-        *out = s;
-        return TK_OK;
-    }
-    if (c) {
-        tk_error_set(err, TK_EIO, "cannot set up the job store %s: %.200s", s->label,
-                     s->db->error(c));
-        give(s, c); /* rolls back a part done */
-    }
-    tk_store_close(&s);
-    return TK_EIO;
-}
-
-void tk_store_close(tk_store **p)
-{
-    tk_store *s = p ? *p : NULL;
-    if (!s)
-        return;
-    while (s->nidle)
-        s->db->disconnect(s->idle[--s->nidle]);
-    for (size_t i = 0; i < RECENT_MAX; i++)
-        json_decref(s->recent[i].doc);
-    pthread_mutex_destroy(&s->lock);
-    free(s->where);
-    free(s);
-    *p = NULL;
-}
-
-bool tk_store_shared(const tk_store *s)
-{
-    return s->pg;
-}
-
-const char *tk_store_holder(const tk_store *s)
-{
-    return s->holder;
-}
 
 /* ---- the operations ---- */
 
@@ -202,9 +64,9 @@ static int which_limit(tk_store *s, const char *owner, const tk_store_limits *li
 int tk_store_add(tk_store *s, json_t *doc, const char *input, const tk_store_limits *limits,
                  tk_error *err)
 {
-    void *c = take(s, err);
+    void *c = store_take(s, err);
     if (!c)
-        return written(s, TK_EIO, err);
+        return store_written(s, TK_EIO, err);
     char *text = doc_text(doc);
     const char *owner = json_string_value(json_object_get(doc, "owner"));
     /* under one lock across daemons, the insert's counts see every
@@ -214,13 +76,13 @@ int tk_store_add(tk_store *s, json_t *doc, const char *input, const tk_store_lim
               db_query(s->db, c, &r, s->db->add, "jxitii", text, input, (int64_t)limits->queued,
                     owner, (int64_t)limits->per_owner, (int64_t)limits->bytes);
     ok = ok && db_script(s->db, c, "COMMIT");
-    int rc = !ok ? failed(s, c, err, "adding a job") : r.n == 1 ? TK_OK : TK_EBUSY;
+    int rc = !ok ? store_failed(s, c, err, "adding a job") : r.n == 1 ? TK_OK : TK_EBUSY;
     if (!rc)
         json_object_set_new(doc, "id", json_integer(rows_int(&r, 0, 0)));
     rows_free(&r);
     free(text);
-    give(s, c);
-    return rc == TK_EBUSY ? which_limit(s, owner, limits, err) : written(s, rc, err);
+    store_give(s, c);
+    return rc == TK_EBUSY ? which_limit(s, owner, limits, err) : store_written(s, rc, err);
 }
 
 int tk_store_put(tk_store *s, const json_t *doc, const char *const *parts,
@@ -233,9 +95,9 @@ int tk_store_put_within(tk_store *s, const json_t *doc, const char *const *parts
                         const tk_frame *frames, size_t first, size_t nframes, size_t owner_bytes,
                         size_t *fit, tk_error *err)
 {
-    void *c = take(s, err);
+    void *c = store_take(s, err);
     if (!c)
-        return written(s, TK_EIO, err);
+        return store_written(s, TK_EIO, err);
     int64_t id = tk_job_id(doc);
     char *text = doc_text(doc);
     const char *const *p = parts ? parts : (const char *const[TK_PARTS]){NULL};
@@ -277,10 +139,10 @@ int tk_store_put_within(tk_store *s, const json_t *doc, const char *const *parts
                    frames[i].count * sizeof(double), frames[i].layout);
     ok = ok && !rc && db_script(s->db, c, "COMMIT");
     if (!ok && !rc)
-        rc = failed(s, c, err, "writing a job");
+        rc = store_failed(s, c, err, "writing a job");
     free(text);
-    give(s, c); /* rolls back what did not commit */
-    return written(s, rc, err);
+    store_give(s, c); /* rolls back what did not commit */
+    return store_written(s, rc, err);
 }
 
 /* The document of row i of (doc, id, state): the id and state are the
@@ -307,15 +169,15 @@ static int ask(tk_store *s, rows *r, const char *what, tk_error *err, const char
                const char *types, ...)
 {
     *r = (rows){0};
-    void *c = sql ? take(s, err) : NULL; /* no statement here: no connection either */
+    void *c = sql ? store_take(s, err) : NULL; /* no statement here: no connection either */
     if (!c)
         return sql ? TK_EIO : TK_OK;
     va_list ap;
     va_start(ap, types);
     bool ok = db_vquery(s->db, c, r, sql, types, ap);
     va_end(ap);
-    int rc = ok ? TK_OK : failed(s, c, err, what);
-    give(s, c);
+    int rc = ok ? TK_OK : store_failed(s, c, err, what);
+    store_give(s, c);
     return rc;
 }
 
@@ -412,7 +274,7 @@ static int change(tk_store *s, const char *sql, int64_t id, const char *two, con
     if (!rc && !r.changed)
         rc = tk_error_set(err, TK_EINVAL, "job %lld %s", (long long)id, why);
     rows_free(&r);
-    return written(s, rc, err);
+    return store_written(s, rc, err);
 }
 
 /* The document read, its end set, and written back only while it is the
@@ -431,7 +293,7 @@ int tk_store_cancel(tk_store *s, int64_t id, tk_error *err)
                     " 'queued' AND CAST(doc AS TEXT) = $3", id, text, rows_cell(&r, 0, 0),
                     "is not queued", err);
     else if (!rc)
-        rc = written(s, tk_error_set(err, TK_EINVAL, "job %lld is not queued", (long long)id), err);
+        rc = store_written(s, tk_error_set(err, TK_EINVAL, "job %lld is not queued", (long long)id), err);
     free(text);
     json_decref(doc);
     rows_free(&r);
@@ -455,7 +317,7 @@ int tk_store_requeue(tk_store *s, tk_error *err)
     rows r;
     int rc = ask(s, &r, "queueing unfinished jobs", err, s->db->requeue, "");
     rows_free(&r);
-    return written(s, rc, err);
+    return store_written(s, rc, err);
 }
 
 int tk_store_claim(tk_store *s, int64_t *id, tk_error *err)
@@ -466,7 +328,7 @@ int tk_store_claim(tk_store *s, int64_t *id, tk_error *err)
     if (!rc && !*id)
         rc = tk_error_set(err, TK_ENOTFOUND, "no job is queued");
     rows_free(&r);
-    return written(s, rc, err);
+    return store_written(s, rc, err);
 }
 
 int tk_store_renew(tk_store *s, int64_t id, bool *cancel, tk_error *err)
@@ -477,7 +339,7 @@ int tk_store_renew(tk_store *s, int64_t id, bool *cancel, tk_error *err)
         rc = tk_error_set(err, TK_ENOTFOUND, "job %lld is not held here", (long long)id);
     *cancel = !rc && rows_int(&r, 0, 0) != 0;
     rows_free(&r);
-    return written(s, rc, err);
+    return store_written(s, rc, err);
 }
 
 int tk_store_frames(tk_store *s, int64_t id, size_t offset, size_t limit, tk_frame **out,

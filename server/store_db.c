@@ -1,4 +1,5 @@
-/* tightknot service: what the store's two backends share (store_db.h). */
+/* tightknot service: what the store's two backends share (store_db.h):
+ * rows, parameters, and the connections, opened once and kept for reuse. */
 #include "store_db.h"
 
 #include <assert.h>
@@ -6,6 +7,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/random.h>
+#include <unistd.h>
+
+#include "store.h"
 
 void rows_free(rows *r)
 {
@@ -100,3 +105,110 @@ bool db_query(const backend *db, void *c, rows *out, const char *sql, const char
     return ok;
 }
 
+/* ---- connections ---- */
+
+/* The connection's last error, on one line, as TK_EIO. */
+int store_failed(const tk_store *s, void *c, tk_error *err, const char *what)
+{
+    const char *m = s->db->error(c);
+    size_t n = strcspn(m, "\n");
+    return tk_error_set(err, TK_EIO, "job store: %s: %.*s", what, (int)n, n ? m : "no answer");
+}
+
+/* A connection for this call; the lock only guards the list. */
+void *store_take(tk_store *s, tk_error *err)
+{
+    pthread_mutex_lock(&s->lock);
+    void *c = s->nidle ? s->idle[--s->nidle] : NULL;
+    pthread_mutex_unlock(&s->lock);
+    return c ? c : s->db->connect(s->where, s->label, false, err);
+}
+
+/* Back to the list, what did not commit rolled back, unless it broke (a
+ * lost server). */
+void store_give(tk_store *s, void *c)
+{
+    bool keep = s->db->release(c);
+    pthread_mutex_lock(&s->lock);
+    if (keep && s->nidle < IDLE_MAX) {
+        s->idle[s->nidle++] = c;
+        c = NULL;
+    }
+    pthread_mutex_unlock(&s->lock);
+    if (c)
+        s->db->disconnect(c);
+}
+
+/* Notes a write's outcome for health: a failure to reach or write the
+ * store (TK_EIO, TK_ENOMEM) until the next write that succeeds; answers
+ * about the job (busy, not found, not queued) are neither.  Returns rc. */
+int store_written(tk_store *s, int rc, const tk_error *err)
+{
+    pthread_mutex_lock(&s->lock);
+    s->writes++;
+    if (rc == TK_OK || rc == TK_EIO || rc == TK_ENOMEM)
+        snprintf(s->write_error, sizeof s->write_error, "%s", rc ? err->message : "");
+    pthread_mutex_unlock(&s->lock);
+    return rc;
+}
+
+/* ---- opening ---- */
+
+int tk_store_open(const char *where, double lease, tk_store **out, tk_error *err)
+{
+    *out = NULL;
+    tk_store *s = calloc(1, sizeof *s);
+    if (!s || !(s->where = strdup(where))) {
+        free(s);
+        return tk_error_set(err, TK_ENOMEM, "out of memory");
+    }
+    s->pg = !strncmp(where, "postgresql://", 13) || !strncmp(where, "postgres://", 11);
+    s->db = s->pg ? tk_store_pg() : tk_store_sqlite();
+    s->db->label(where, s->label, sizeof s->label);
+    s->lease = lease;
+    pthread_mutex_init(&s->lock, NULL);
+    char host[64] = "host";
+    gethostname(host, sizeof host - 1);
+    unsigned long long nonce = 0;
+    if (getrandom(&nonce, sizeof nonce, 0) != (ssize_t)sizeof nonce)
+        nonce = (unsigned long long)(uintptr_t)s ^ (unsigned long long)getpid();
+    snprintf(s->holder, sizeof s->holder, "%.63s:%ld:%016llx", host, (long)getpid(), nonce);
+    void *c = s->db->connect(where, s->label, true, err);
+    if (c && s->db->setup(c)) {
+        s->idle[s->nidle++] = c;
+        *out = s;
+        return TK_OK;
+    }
+    if (c) {
+        tk_error_set(err, TK_EIO, "cannot set up the job store %s: %.200s", s->label,
+                     s->db->error(c));
+        store_give(s, c); /* rolls back a part done */
+    }
+    tk_store_close(&s);
+    return TK_EIO;
+}
+
+void tk_store_close(tk_store **p)
+{
+    tk_store *s = p ? *p : NULL;
+    if (!s)
+        return;
+    while (s->nidle)
+        s->db->disconnect(s->idle[--s->nidle]);
+    for (size_t i = 0; i < RECENT_MAX; i++)
+        json_decref(s->recent[i].doc);
+    pthread_mutex_destroy(&s->lock);
+    free(s->where);
+    free(s);
+    *p = NULL;
+}
+
+bool tk_store_shared(const tk_store *s)
+{
+    return s->pg;
+}
+
+const char *tk_store_holder(const tk_store *s)
+{
+    return s->holder;
+}

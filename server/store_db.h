@@ -10,6 +10,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include <jansson.h>
+#include <pthread.h>
+
 #include "tk/error.h"
 
 #define MAX_PARAMS 10
@@ -82,6 +85,47 @@ bool db_vquery(const backend *db, void *c, rows *out, const char *sql, const cha
 
 const backend *tk_store_sqlite(void);
 const backend *tk_store_pg(void);
+
+#define IDLE_MAX 32 /* connections kept for reuse; more are opened while needed */
+/* On a shared store the documents last read are served again for a
+ * moment: a daemon that runs nothing answers a crowd of pollers of a job
+ * running elsewhere from memory, not with a query each (the job's own
+ * daemon writes it only every 2 s anyway).  Any write through this store
+ * drops them all, so a client sees its own DELETE at once. */
+#define RECENT_MAX 64   /* documents kept, one slot per id modulo this */
+#define RECENT_AGE 0.5  /* seconds a kept document is served again */
+
+struct tk_store {
+    const backend *db;
+    bool pg; /* PostgreSQL: shared with other daemons */
+    double lease;
+    char *where;
+    char label[200]; /* where, as messages name it: never a password */
+    char holder[96];
+    pthread_mutex_t lock; /* guards what follows; never held over a statement */
+    void *idle[IDLE_MAX];
+    size_t nidle;
+    char write_error[TK_ERROR_MESSAGE_SIZE]; /* the last write's failure, "" once one succeeds */
+    char damage[TK_ERROR_MESSAGE_SIZE];      /* the first damage a reader found */
+    uint64_t writes; /* writes through this store so far */
+    struct kept {
+        int64_t id;
+        uint64_t writes; /* the count when it was read: stale once another write came */
+        double at;       /* when it was read (monotonic seconds) */
+        json_t *doc;     /* never handed out: copies are */
+    } recent[RECENT_MAX];
+};
+
+/* The connection's last error, on one line, as TK_EIO saying `what` failed. */
+int store_failed(const struct tk_store *s, void *c, tk_error *err, const char *what);
+/* A connection for this call (kept, or a new one), and back: what did not
+ * commit rolled back, kept unless it broke (a lost server). */
+void *store_take(struct tk_store *s, tk_error *err);
+void store_give(struct tk_store *s, void *c);
+/* Notes a write's outcome for health: a failure to reach or write the
+ * store (TK_EIO, TK_ENOMEM) until the next write that succeeds; answers
+ * about the job (busy, not found, not queued) are neither.  Returns rc. */
+int store_written(struct tk_store *s, int rc, const tk_error *err);
 
 /* The advisory lock that makes a submission's limits and insert one step
  * across daemons (any number no other program on the database uses). */
