@@ -146,7 +146,7 @@ int tk_store_put_within(tk_store *s, const json_t *doc, const char *const *parts
 }
 
 /* The document of row i of (doc, id, state): the id and state are the
- * columns'.  NULL (TK_EIO in err, and the store reported damaged) when
+ * columns'.  NULL (TK_EPARSE in err, and the store reported damaged) when
  * it does not read back: SQLite checks its pages, not a row's bytes. */
 static json_t *row_doc(tk_store *s, const rows *r, size_t i, tk_error *err)
 {
@@ -157,7 +157,7 @@ static json_t *row_doc(tk_store *s, const rows *r, size_t i, tk_error *err)
         return doc;
     }
     json_decref(doc);
-    tk_error_set(err, TK_EIO, "the stored document of job %lld does not read back",
+    tk_error_set(err, TK_EPARSE, "the stored document of job %lld does not read back",
                  (long long)rows_int(r, i, 1));
     tk_store_damage(s, err->message);
     return NULL;
@@ -215,7 +215,7 @@ int tk_store_get(tk_store *s, int64_t id, json_t **doc, tk_error *err)
     if (!rc)
         rc = !r.n ? tk_error_set(err, TK_ENOTFOUND, "there is no job %lld", (long long)id)
              : (*doc = row_doc(s, &r, 0, err)) ? TK_OK
-                                                : TK_EIO;
+                                                : TK_EPARSE;
     rows_free(&r);
     if (!rc && s->pg)
         recent(s, id, writes, at, *doc);
@@ -259,7 +259,7 @@ int tk_store_list(tk_store *s, int state, const char *owner, size_t offset, size
         if ((doc = row_doc(s, &r, i, err)) != NULL)
             json_array_append_new(*docs, doc);
         else
-            rc = TK_EIO;
+            rc = TK_EPARSE;
     rows_free(&r);
     return rc;
 }

@@ -87,7 +87,9 @@ int tk_store_put_within(tk_store *s, const json_t *doc, const char *const *parts
                         const tk_frame *frames, size_t first, size_t nframes, size_t owner_bytes,
                         size_t *fit, tk_error *err);
 
-/* The job's document (TK_ENOTFOUND when there is none).  On a shared
+/* The job's document (TK_ENOTFOUND when there is none; TK_EPARSE, the
+ * store reported damaged, when it does not read back: damage, not an
+ * outage, so a 500 and not a 503).  On a shared
  * store it may be one read up to half a second ago, unless a write went
  * through this store since. */
 int tk_store_get(tk_store *s, int64_t id, json_t **doc, tk_error *err);
