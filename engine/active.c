@@ -41,6 +41,11 @@ int tk_constraints_copy(tk_constraints *dst, const tk_constraints *src, tk_error
     return TK_OK;
 }
 
+int tk_active_restore(tk_run *r, const tk_constraints *set, tk_error *err)
+{
+    return tk_constraints_copy(&r->active.set, set, err);
+}
+
 void tk_active_free(tk_run *r)
 {
     tk_constraints_free(&r->active.set);

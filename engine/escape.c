@@ -73,6 +73,13 @@
  * 60.99699 (seed 1 spends its tries before the reserve). */
 #define ESCAPE_RESERVE 0.2
 
+void tk_escape_start(tk_run *r, bool resumed)
+{
+    r->escape.rng = r->opt.seed;
+    r->escape.coarse = r->escape.best_coarse = NAN;
+    r->escape.explore_over = resumed; /* its exploration's best is not kept */
+}
+
 void tk_escape_free(tk_run *r)
 {
     tk_curve_free(&r->escape.best);

@@ -62,8 +62,8 @@ int tk_field_set(const tk_field *f, void *record, double x, tk_error *err)
                             label(f), x);
     /* (NaN: a JSON null, the only way to give one) */
     if (!measured && isnan(x))
-        return tk_error_set(err, TK_EINVAL, "option '%s': must be a number from %.16g to %.16g, "
-                            "not null", label(f), f->min, f->max);
+        return tk_error_set(err, TK_EINVAL, "option '%s': must be from %.16g to %.16g, not null "
+                            "(no number)", label(f), f->min, f->max);
     if (!measured && !(x >= f->min && x <= f->max))
         return tk_error_set(err, TK_EINVAL, "option '%s': must be from %.16g to %.16g, not %.17g",
                             label(f), f->min, f->max, x);

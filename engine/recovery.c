@@ -1,8 +1,8 @@
-/* Error recovery (section 4.6): how far the curve violates its
- * constraints, and Newton steps back into the feasible set.  It works on
- * a constraint set of its own, so the step's active set (with the forces
- * the step reports) is left as it was.  See run.h for the rooms of the
- * flow. */
+/* Error recovery (section 4.6): how far the curve violates its constraints,
+ * Newton steps back into the feasible set, and the curve before a step, kept
+ * to undo it when they fail.  It works on a constraint set of its own, so the
+ * step's active set (with the forces the step reports) is left as it was.
+ * See run.h for the rooms of the flow. */
 #include <assert.h>
 #include <math.h>
 #include <stdlib.h>
@@ -49,7 +49,20 @@ void tk_recovery_free(tk_run *r)
     free(r->recovery.du);
     free(r->recovery.before);
     free(r->recovery.checked);
-    free(r->recovery.held);
+}
+
+void tk_recovery_keep(tk_run *r)
+{
+    const tk_curve *c = r->shared.curve;
+    memcpy(r->recovery.before, c->xyz, 3 * c->nvert * sizeof *c->xyz);
+}
+
+void tk_recovery_undo(tk_run *r, bool counted)
+{
+    tk_curve *c = r->shared.curve;
+    memcpy(c->xyz, r->recovery.before, 3 * c->nvert * sizeof *c->xyz);
+    if (counted)
+        r->recovery.undone++;
 }
 
 int tk_recovery_fit(tk_run *r, size_t vertices, tk_error *err)
@@ -57,13 +70,11 @@ int tk_recovery_fit(tk_run *r, size_t vertices, tk_error *err)
     free(r->recovery.du);
     free(r->recovery.before);
     free(r->recovery.checked);
-    free(r->recovery.held);
-    r->recovery.held = calloc(3 * vertices, sizeof *r->recovery.held);
     r->recovery.du = calloc(3 * vertices, sizeof *r->recovery.du);
     r->recovery.before = calloc(3 * vertices, sizeof *r->recovery.before);
     r->recovery.checked = calloc(3 * vertices, sizeof *r->recovery.checked);
     r->recovery.checked_vertices = 0;
-    if (!r->recovery.du || !r->recovery.before || !r->recovery.checked || !r->recovery.held)
+    if (!r->recovery.du || !r->recovery.before || !r->recovery.checked)
         return tk_error_set(err, TK_ENOMEM, "out of memory for a run of %zu vertices", vertices);
     return TK_OK;
 }

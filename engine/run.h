@@ -1,35 +1,71 @@
 /* tightknot: the state of a run and the rooms of the flow (private to
  * engine/; the public API is tk/tighten.h).
  *
- * A step of the flow (tighten.c, tk_run_step) goes through the rooms in
- * this order, each deciding one thing:
+ * The files stand in one order, lowest first; each calls only files below
+ * it or on its own level, and two on one level never call each other
+ * (tools/engine-calls.sh checks it on the object files; make lint runs it):
  *
+ *   libraries   curve, geometry, struts, thickness, rigidity, nnls,
+ *               invariants, vect, generate, record, error: no run state
+ *   queries.c   read-only questions every room asks, writing nothing: the
+ *               clock, the history's fall, whether the polygon is the final
+ *               one, its mean edge, the tolerances of the step (shrunk by
+ *               the schedule's polishing level)
+ *   type.c      the knot or link type: the start's, and the check that the
+ *               run's curve still has it
+ *   active.c    the active set: the struts and kinks that hold the motion
+ *   motion.c    the resolved motion (equation 13)
+ *   stepping.c  the step (section 4.5) and its retries: a step that error
+ *               recovery cannot restore is undone and taken shorter
+ *   recovery.c  error recovery (section 4.6), and the curve before a step,
+ *               kept to undo it
+ *   schedule.c  the polygon: the start, coarse to fine, re-resolution and
+ *               the polishing levels; the only room that changes the
+ *               vertex count
+ *   escape.c    when the final polygon has converged: a deformation of the
+ *               best curve so far, tightened again (the schedule restarts
+ *               from it), and the best curve restored when the run stops
+ *   tighten.c   the run: creation, the order of a step, its figures, the
+ *               history and snapshots, the stop criteria
+ *
+ * Stepping and recovery stand on one level (stepping calls recovery), as
+ * do schedule and escape (escape calls schedule).  What a room needs to
+ * know from one above it is passed down as an argument (tk_schedule_watch
+ * is told whether escapes judge their tries on the polygon), never asked
+ * by calling up.
+ *
+ * A step (tighten.c, tk_run_step) goes through the rooms in this order,
+ * each deciding one thing:
+ *
+ *   escape.c    before the step: the deformation asked for after an
+ *               earlier step, or the best curve back
  *   schedule.c  before the step: a coarse polygon refined, or the polygon
  *               re-resolved (decided after an earlier step, carried out
  *               here, so that a step's figures and its curve always
  *               describe the same polygon)
- *   active.c    the active set: the struts and kinks that hold the motion
- *   stepping.c  the step (section 4.5), which asks motion.c for the
- *               resolved motion (equation 13) and active.c for the
- *               constraints a step runs into
+ *   stepping.c  the step's first attempt (tk_stepping_begin): the active
+ *               set (active.c), the resolved motion (motion.c), the step
  *   schedule.c  polishing: the tolerances shrink when the ropelength all
- *               but stops falling (or, on a coarse polygon, the next
- *               level is due)
- *   recovery.c  error recovery (section 4.6)
+ *               but stops falling (or, on a coarse polygon, the next level
+ *               is due); after the motion, before error recovery, which
+ *               then works to the new tolerances
+ *   stepping.c  the rest of the step (tk_stepping_finish): error recovery
+ *               (recovery.c), and a shorter step when it fails
  *   tighten.c   the step's figures, the history, the stop criteria (and
  *               the schedule's other cues to move on: a stall, a spent
  *               share of the budget)
- *   escape.c    when the final polygon has converged: a deformation of the
- *               best curve so far, tightened again from before the next
- *               step (carried out by schedule.c), and the best curve
- *               restored when the run stops
+ *   escape.c    after the figures: the best final curve so far kept, and
+ *               on convergence an escape asked for
  *
  * Each room owns the sub-struct named after it: only its file writes it,
- * the others read.  The shared part (the curve, the trial curve, the strut
- * finder, the solver) is made by tighten.c and resized by schedule.c
- * alone, the only room that changes the vertex count; stepping.c and
- * recovery.c move the curve's coordinates (and every room refits the
- * finder to the curve it measures).
+ * the others read, and a room that needs another's state changed asks its
+ * owner through a function (tk_recovery_keep and tk_recovery_undo,
+ * tk_active_restore, tk_stepping_resume, tk_escape_start).  The shared
+ * part (the curve, the trial curve, the strut finder, the solver) is made
+ * by tighten.c and resized by schedule.c alone, the only room that
+ * changes the vertex count; stepping.c and recovery.c move the curve's
+ * coordinates (and every room refits the finder to the curve it
+ * measures).
  */
 #ifndef TK_ENGINE_RUN_H
 #define TK_ENGINE_RUN_H
@@ -108,6 +144,9 @@ struct tk_run {
         double seconds;
         long length_steps; /* judged by their length (take_step) */
         long corrected_steps; /* judged after their correction (take_step) */
+        int tiny_before; /* tiny_steps before this step's attempts */
+        double *held;    /* 3V: the run's curve while a step's trial is
+                            corrected */
     } stepping;
 
     struct {             /* recovery.c */
@@ -117,8 +156,6 @@ struct tk_run {
         double *du;      /* 3V: a Newton step */
         double *before;  /* 3V: the curve before this step, to undo it */
         double *checked; /* 3V: the curve last checked, and what it gave */
-        double *held;    /* 3V: the run's curve while a step's trial is
-                            corrected (stepping.c) */
         size_t checked_vertices; /* 0: none */
         double checked_worst;
         double seconds, nnls_seconds, check_seconds;
@@ -209,7 +246,7 @@ struct tk_run {
         double figures_seconds; /* a step's figures measured and recorded */
     } life;
 
-    struct {             /* tighten.c: the knot or link type */
+    struct {             /* type.c: the knot or link type */
         tk_invariants start;   /* of the input, as given */
         tk_invariants latest;  /* of the run's curve at the last check */
         long checked_step;     /* the step of the last check, -1 before */
@@ -217,9 +254,6 @@ struct tk_run {
         double seconds;
     } type;
 };
-
-/* Monotonic wall time in seconds, for the timing figures. */
-double tk_clock(void);
 
 /* Grows *v (capacity *cap) to hold n doubles, doubling from 64. */
 static inline int tk_grow_doubles(double **v, size_t *cap, size_t n, tk_error *err)
@@ -245,11 +279,10 @@ static inline double tk_norm(const double *v, size_t n)
     return sqrt(s);
 }
 
-/* ---- tighten.c ---- */
+/* ---- queries.c: read-only, below every room ---- */
 
-/* The run's curve still has the start's knot or link type; else TK_ETYPE
- * with a message that begins with `when` ("resampling to 400 vertices"). */
-int tk_type_check(tk_run *r, const char *when, tk_error *err);
+/* Monotonic wall time in seconds, for the timing figures. */
+double tk_clock(void);
 
 /* How much the ropelength fell over the last `window` entries of the
  * history, relative: the lowest over them below the lowest over the
@@ -270,6 +303,37 @@ int tk_type_check(tk_run *r, const char *when, tk_error *err);
  * `from` holds no more than `window` entries. */
 bool tk_history_fall(const tk_run *r, size_t from, size_t window, double *fall);
 
+/* Whether the run is on its final polygon (no coarse level left). */
+bool tk_schedule_final(const tk_run *r);
+
+/* The mean edge of the run's polygon over the diameter (0 when unknown). */
+double tk_mean_edge(const tk_run *r);
+
+/* The tolerances of the step, as fractions of the diameter: the active
+ * one (a constraint within it holds the motion), the kinks' (as strict or
+ * looser where kinks are stiff), the overstep (the largest violation a
+ * step may make) and the correction (what error recovery corrects down
+ * to).  All shrink by tk_polish_scale's factor as the run polishes. */
+double tk_tolerance_active(const tk_run *r);
+double tk_tolerance_kink(const tk_run *r);
+double tk_tolerance_overstep(const tk_run *r);
+double tk_tolerance_correction(const tk_run *r);
+/* The factor the schedule's polishing level takes the tolerances down by. */
+double tk_polish_scale(const tk_run *r);
+/* Whether the active tolerance is reckoned from the mean edge (on a fine
+ * polygon) rather than the options'. */
+bool tk_tolerance_from_edge(const tk_run *r);
+
+/* ---- type.c: below every room ---- */
+
+/* The start's knot or link type: `known` copied (a resumed run's), or told
+ * from `start` as given. */
+int tk_type_start(tk_run *r, const tk_curve *start, const tk_invariants *known, tk_error *err);
+/* The run's curve still has the start's knot or link type; else TK_ETYPE
+ * with a message that begins with `when` ("resampling to 400 vertices"). */
+int tk_type_check(tk_run *r, const char *when, tk_error *err);
+void tk_type_free(tk_run *r);
+
 /* ---- active.c ---- */
 
 /* The active constraints of curve c into *set (the finder must be fitted
@@ -288,6 +352,8 @@ int tk_active_set_forces(tk_run *r, const double *x, tk_error *err);
 void tk_active_guess_forces(const tk_run *r, double *x);
 /* The kinks as reported (one per vertex, forces summed). */
 int tk_active_report(tk_run *r, tk_error *err);
+/* The active set becomes a copy of `set` (the best curve's, put back). */
+int tk_active_restore(tk_run *r, const tk_constraints *set, tk_error *err);
 /* A new polygon: no active set, no warm start. */
 void tk_active_reset(tk_run *r);
 void tk_active_free(tk_run *r);
@@ -306,11 +372,25 @@ void tk_motion_free(tk_run *r);
 
 /* ---- stepping.c ---- */
 
-/* Resolves the motion and takes the step (section 4.5). */
-int tk_stepping_step(tk_run *r, tk_step_report *rep, tk_error *err);
+/* A step's first attempt: the curve kept to undo it (tk_recovery_keep),
+ * the active set found, the motion resolved and the step taken (section
+ * 4.5).  The step's figures go into *rep. */
+int tk_stepping_begin(tk_run *r, tk_step_report *rep, tk_error *err);
+/* The rest of the step after tk_stepping_begin (whose status is rc): its
+ * violations corrected (error recovery, when over half the overstep
+ * tolerance); when Newton steps cannot restore the thickness, the step
+ * undone and taken again a quarter as long, up to STEP_ATTEMPTS in all,
+ * and failing that no step, the curve corrected as a start's is.  The
+ * finder is left fitted to the run's curve. */
+int tk_stepping_finish(tk_run *r, tk_step_report *rep, int rc, tk_error *err);
 /* The step size has been nothing for too many steps. */
 bool tk_stepping_stalled(const tk_run *r);
 void tk_stepping_reset(tk_run *r);
+/* A run's first step size: a resumed run's last, or 0 (the first step
+ * then tries an eighth of the largest). */
+void tk_stepping_resume(tk_run *r, double step_size);
+int tk_stepping_fit(tk_run *r, size_t vertices, tk_error *err);
+void tk_stepping_free(tk_run *r);
 
 /* ---- recovery.c ---- */
 
@@ -346,11 +426,62 @@ int tk_recovery_correct(tk_run *r, int most, double rescale_up_to, int *iteratio
 #define TK_RESCALE_START(r) (10.0 * (r)->opt.overstep_tolerance)
 /* Scales the curve about its centroid to undo a violation `worst`. */
 void tk_recovery_rescale(tk_run *r, double worst);
+/* Keeps the run's curve as it is before a step, to undo the step. */
+void tk_recovery_keep(tk_run *r);
+/* The run's curve back to the one kept; `counted` among the undone steps
+ * (tk_run_timing) when it is a step given up for a shorter one. */
+void tk_recovery_undo(tk_run *r, bool counted);
 int tk_recovery_fit(tk_run *r, size_t vertices, tk_error *err);
 void tk_recovery_free(tk_run *r);
 
+/* ---- schedule.c ---- */
+
+/* The run's curve from `start`: resampled (to the coarsest level's count)
+ * and autoscaled as the options ask, and everything sized by it. */
+int tk_schedule_start(tk_run *r, const tk_curve *start, tk_error *err);
+/* A resumed run's schedule: its curve as it is, at the level, polishing
+ * and share of `at` (tk_schedule_resume_point's). */
+int tk_schedule_resume(tk_run *r, const tk_curve *curve, const tk_resume *at, tk_error *err);
+void tk_schedule_resume_point(const tk_run *r, tk_resume *out);
+/* Resizes the shared part and the rooms' vectors to the run's curve. */
+int tk_schedule_fit(tk_run *r, tk_error *err);
+/* The run's curve replaced by `curve` (taken over): with `coarse` the
+ * schedule starts again from its coarsest level (the curve resampled to
+ * it), else `curve` is on the final polygon (the escapes' best): it keeps
+ * its vertices, the schedule is at the final level and the polishing
+ * level is `polish`; made feasible by scaling, type-checked. */
+int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_error *err);
+/* The same on the coarsest level before the final polygon is fixed (the
+ * escapes' exploration): `curve` resampled to that level's vertices at
+ * ropelength `rope`, or kept as it is with 0. */
+int tk_schedule_explore(tk_run *r, tk_curve *curve, double rope, tk_error *err);
+/* The vertices of the coarsest level at ropelength `rope`. */
+size_t tk_schedule_coarsest_count(tk_run *r, double rope);
+/* The fraction of the step or time budget spent (0 without one). */
+double tk_schedule_spent(const tk_run *r);
+/* The same at the step of report s. */
+double tk_schedule_spent_at(const tk_run *r, const tk_step_report *s);
+/* Before a step: refines or re-resolves if due. */
+int tk_schedule_before_step(tk_run *r, tk_error *err);
+/* After a step's motion: polishing (or, on a coarse polygon, moving on).
+ * `judged_here`: tk_escape_judged_here's answer, passed down by the run
+ * (a coarse level where tries are judged is polished as the final one). */
+void tk_schedule_watch(tk_run *r, bool judged_here);
+/* Refine before the next step; false on the final polygon. */
+bool tk_schedule_move_on(tk_run *r);
+/* On a coarse polygon, whether its share of the step or time budget is
+ * spent. */
+bool tk_schedule_share_spent(const tk_run *r);
+size_t tk_schedule_final_count(const tk_run *r);
+/* A window of `steps` steps at resolution 5, counted for the run's
+ * polygon: as many more steps as its mean edge is shorter. */
+size_t tk_schedule_window(const tk_run *r, size_t steps);
+
 /* ---- escape.c ---- */
 
+/* A new run's escapes: the random stream at the seed, nothing explored
+ * or noted yet (a resumed run explores no more). */
+void tk_escape_start(tk_run *r, bool resumed);
 /* Whether the final polygon has converged: its ropelength fell by less
  * than a set fraction over a window of steps, or by less than a larger
  * one for a set share of the budget (a crawl). */
@@ -385,50 +516,7 @@ int tk_escape_resume(tk_run *r, const tk_resume *at, const tk_curve *best,
                      const tk_step_report *best_report, tk_error *err);
 void tk_escape_free(tk_run *r);
 
-/* ---- schedule.c ---- */
-
-/* The run's curve from `start`: resampled (to the coarsest level's count)
- * and autoscaled as the options ask, and everything sized by it. */
-int tk_schedule_start(tk_run *r, const tk_curve *start, tk_error *err);
-/* A resumed run's schedule: its curve as it is, at the level, polishing
- * and share of `at` (tk_schedule_resume_point's). */
-int tk_schedule_resume(tk_run *r, const tk_curve *curve, const tk_resume *at, tk_error *err);
-void tk_schedule_resume_point(const tk_run *r, tk_resume *out);
-/* Resizes the shared part and the rooms' vectors to the run's curve. */
-int tk_schedule_fit(tk_run *r, tk_error *err);
-/* The run's curve replaced by `curve` (taken over): with `coarse` the
- * schedule starts again from its coarsest level (the curve resampled to
- * it), else `curve` is on the final polygon (the escapes' best): it keeps
- * its vertices, the schedule is at the final level and the polishing
- * level is `polish`; made feasible by scaling, type-checked. */
-int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_error *err);
-/* The same on the coarsest level before the final polygon is fixed (the
- * escapes' exploration): `curve` resampled to that level's vertices at
- * ropelength `rope`, or kept as it is with 0. */
-int tk_schedule_explore(tk_run *r, tk_curve *curve, double rope, tk_error *err);
-/* The vertices of the coarsest level at ropelength `rope`. */
-size_t tk_schedule_coarsest_count(tk_run *r, double rope);
-/* The fraction of the step or time budget spent (0 without one). */
-double tk_schedule_spent(const tk_run *r);
-/* The same at the step of report s. */
-double tk_schedule_spent_at(const tk_run *r, const tk_step_report *s);
-/* Before a step: refines or re-resolves if due. */
-int tk_schedule_before_step(tk_run *r, tk_error *err);
-/* After a step's motion: polishing (or, on a coarse polygon, moving on). */
-void tk_schedule_watch(tk_run *r);
-/* Refine before the next step; false on the final polygon. */
-bool tk_schedule_move_on(tk_run *r);
-/* On a coarse polygon, whether its share of the step or time budget is
- * spent. */
-bool tk_schedule_share_spent(const tk_run *r);
-bool tk_schedule_final(const tk_run *r);
-size_t tk_schedule_final_count(const tk_run *r);
-/* A window of `steps` steps at resolution 5, counted for the run's
- * polygon: as many more steps as its mean edge is shorter. */
-size_t tk_schedule_window(const tk_run *r, size_t steps);
-double tk_tolerance_active(const tk_run *r);
-double tk_tolerance_overstep(const tk_run *r);
-double tk_tolerance_kink(const tk_run *r);
-double tk_tolerance_correction(const tk_run *r);
+/* (tighten.c, above every room, declares nothing here: its functions are
+ * tk/tighten.h's.) */
 
 #endif

@@ -1,5 +1,6 @@
-/* The schedule: the polygon a run starts from, the tolerances as the run
- * polishes, coarse to fine and re-resolution.  The only room that changes
+/* The schedule: the polygon a run starts from, polishing (the levels
+ * the tolerances of queries.c shrink by), coarse to fine and
+ * re-resolution.  The only room that changes
  * the vertex count.  See run.h for the rooms of the flow. */
 #include <math.h>
 #include <stdio.h>
@@ -10,10 +11,10 @@
 
 /* Each time the ropelength falls by less than POLISH_CHANGE (relative;
  * shrinking with the tolerances) over POLISH_WINDOW steps, the active
- * tolerance shrinks by POLISH_FACTOR, at most POLISH_LEVELS times. */
+ * tolerance shrinks by POLISH_FACTOR (queries.c), at most POLISH_LEVELS
+ * times. */
 #define POLISH_WINDOW 200
 #define POLISH_CHANGE 1e-4
-#define POLISH_FACTOR (1.0 / 3.0)
 #define POLISH_LEVELS 4
 /* A level also ends when its curve is critical: the residual of each of
  * its last POLISH_CRITICAL_STEPS steps below POLISH_CRITICAL.  The fall
@@ -56,64 +57,20 @@
  * (1,066 steps of 1.3 s in 1,400 s, 32.7539 at the end), while a run
  * kept at 2,400 was at 32.7434 by 600 s. */
 #define WINDOW_EDGE 0.1
-/* On a fine polygon the active tolerance is at most ACTIVE_PER_EDGE2
- * times the squared mean edge (in diameters).  Next to a contact of
- * nearly parallel strands the k-th pair along them is farther by about
- * (k h)^2 times their relative curvature, so a fixed tolerance holds a
- * number of pairs per contact that grows as 1 / h: at 2,400 vertices
- * 3e-4 made 32,000 struts of the tight trefoil active (13 a vertex) and
- * a step took 9.6 s, nearly all of it the NNLS; at 3e-5, 3,500 struts
- * and 0.1 s (bench/steps).  One tolerance of the order of h^2 keeps the
- * pair next to a contact (the parallel case, tk_active_find) whatever
- * the resolution.  Measured on 3.1 at resolution 33 (1,211 vertices),
- * 150 s with four runs sharing two cores: 32.7531 with 3e-4 throughout;
- * 32.7437, 32.7454, 32.7439, 32.7438, 32.7442 and 32.7525 with factors
- * 0.1, 0.2, 0.3, 0.4, 0.65 and 1.5.  Below about 520 vertices of a tight
- * trefoil the options' tolerance is the smaller. */
-#define ACTIVE_PER_EDGE2 0.3
-/* Where the active tolerance is reckoned from the edge (above), polishing
- * takes it down at most POLISH_LEVELS_EDGE levels: to 0.3 h^2 / 27, about
- * 0.01 h^2, below which the pair next to a contact drops out of the active set
- * and comes back in through the step control.  The test data's tight
- * trefoil at 2,400 vertices held at a fourth level (1.7e-7 of the
- * diameter, 0.004 h^2) flipped from one step to the next between 600 and
+/* Where the active tolerance is reckoned from the edge (ACTIVE_PER_EDGE2,
+ * queries.c), polishing takes it down at most POLISH_LEVELS_EDGE levels: to
+ * 0.3 h^2 / 27, about 0.01 h^2, below which the pair next to a contact drops
+ * out of the active set and comes back in through the step control.  The test
+ * data's tight trefoil at 2,400 vertices held at a fourth level (1.7e-7 of
+ * the diameter, 0.004 h^2) flipped from one step to the next between 600 and
  * 6,400 struts, the larger sets found by the step control (1.3 to 1.5 s a
  * step, the ropelength unmoved over 30 steps), where at the third it held
  * 2,800 struts at 62 ms a step (bench/steps --curve); loose trefoils
- * tightened at 2,400 vertices reached the fourth level after about 340 s
- * and stepped at 5 to 9 s there.  Coarser polygons keep the options'
- * tolerance (below 0.3 h^2: fewer than about 520 vertices of a tight
- * trefoil, 960 of 8_19) and all POLISH_LEVELS levels. */
+ * tightened at 2,400 vertices reached the fourth level after about 340 s and
+ * stepped at 5 to 9 s there.  Coarser polygons keep the options' tolerance
+ * (below 0.3 h^2: fewer than about 520 vertices of a tight trefoil, 960 of
+ * 8_19) and all POLISH_LEVELS levels. */
 #define POLISH_LEVELS_EDGE 3
-/* A kink is active when its radius function is within the active
- * tolerance times the function's stiffness, at most KINK_TOLERANCE_MOST
- * of the bound.  Moving a vertex by d normal to its edges (e in
- * diameters) turns them by 2 d / e; the radius function rho, about
- * e / theta, changes by 2 rho^2 d / e^2, a relative 2 rho d / e^2,
- * where a strut's distance changes by at most 2 d: (rho / tau) / e^2
- * times less slack for the same motion, some 10,000 times at 2,400
- * vertices of a tight trefoil.  With the struts' tolerance, the kinks
- * just outside it, bent at that rate by every step, held the steps there
- * to a median size of 6e-6: catalogue 3.1 tightened at 2,400 vertices
- * for 1,800 s reached 32.743687 at 794 s and stayed; with a cap of 0.1
- * the median step was 4e-3, 32.7437 was passed 3 s after the final
- * polygon was reached (277 s) and the run ended at 32.743289, with 92
- * kinks active a step (median) against 45.  But like a strut, an active
- * kink is held at first order whatever its slack, and 0.1 of it held the
- * disguised figure-eight of bench/starts (resolution 5, 120 s) at 44.45
- * in two runs, where the struts' tolerance gave 42.10995.  The
- * trefoil-2400 of tests/data tightened again for 150 s: 32.743816 with
- * the struts' tolerance (median step 1.9e-5), 32.743807 with 0.01
- * (2.7e-3), 32.743804 with 0.1 (5.4e-3).  With 0.01 the figure-eight
- * crawled too, its 14 to 16 kinks held: from 55.17 (step 2,000) to 43.72
- * in 120 s (the bench: 44.474, never judged converged, no escape), where
- * with the struts' tolerance it ended at 42.10985 after 5 escapes.  So
- * the kinks' own tolerance holds only where they are stiffer than
- * KINK_STIFFNESS_FROM times a strut (edges under 0.022 diameters,
- * resolution 22 and more): not at resolution 5 (stiffness 50), and at
- * 2,400 vertices (about 10,000) as measured above. */
-#define KINK_TOLERANCE_MOST 0.01
-#define KINK_STIFFNESS_FROM 1000.0
 /* Coarse to fine: the coarsest polygon has at least this many vertices
  * per unit ropelength, and at most this many halvings are undone. */
 #define COARSEST_RESOLUTION 2.5
@@ -137,45 +94,9 @@
  * 16-gon with one vertex pulled out: ropelength 48, resampled 1e17). */
 #define START_ROPELENGTH_MAX 1e9
 
-/* The tolerances of this step: the options' while the ropelength falls,
- * each a third smaller every time it all but stops (polishing).  A
- * constraint within the active tolerance holds the motion as if it were
- * in contact: with a slack of up to 3e-4 of the diameter such constraints
- * kept runs settling about 1e-4 (relative) above their critical points
- * (3.1 at resolution 5: 32.7719 at 3e-4, 32.7694 at 1e-4, 32.7689 at
- * 1e-5), while a tolerance that small from the start makes the loose
- * phase slower (contacts are met mid-step and found by the step control
- * instead).  The overstep tolerance stays below the active one (a step's
- * violations must be seen as active next time), the correction tolerance
- * a tenth of that.  Shrinking them costs step length (steps along curved
- * constraints grow as the square root of the overstep tolerance), so each
- * level waits until the ropelength falls by less than the offset the
- * current one leaves (about a third of its active tolerance, relative):
- * a run that merely crawls (past a saddle) keeps its step sizes. */
-static double polish_scale(const tk_run *r)
-{
-    return pow(POLISH_FACTOR, r->schedule.polish_level);
-}
-
-/* The mean edge of the run's polygon over the diameter (0 when unknown):
- * half the ropelength of the last step's figures per edge, or, while a run
- * is set up and has none yet, its curve's length over the diameter per edge.
- * Without that fallback a new or resumed run on a fine polygon corrected
- * its start and found its first active set with the options' tolerance
- * instead of 0.3 h^2: a tight trefoil on 2,400 vertices had 48,585 struts
- * active at step 0 (about 9,000 a step later) and took 321 s to set up. */
-static double mean_edge(const tk_run *r)
-{
-    size_t edges = tk_curve_edge_count(r->shared.curve);
-    double rope = r->life.latest.ropelength;
-    if (!(rope > 0.0 && isfinite(rope)))
-        rope = 2.0 * tk_curve_length(r->shared.curve) / r->tau;
-    return edges > 0 && rope > 0.0 && isfinite(rope) ? rope / (2.0 * (double)edges) : 0.0;
-}
-
 size_t tk_schedule_window(const tk_run *r, size_t steps)
 {
-    double h = mean_edge(r);
+    double h = tk_mean_edge(r);
     if (!(h > 0.0) || h >= WINDOW_EDGE)
         return steps;
     return (size_t)lround((double)steps * WINDOW_EDGE / h);
@@ -185,38 +106,7 @@ size_t tk_schedule_window(const tk_run *r, size_t steps)
  * from the edge (POLISH_LEVELS_EDGE). */
 static int polish_levels(const tk_run *r)
 {
-    double h = mean_edge(r);
-    return h > 0.0 && ACTIVE_PER_EDGE2 * h * h < r->opt.active_tolerance ? POLISH_LEVELS_EDGE
-                                                                          : POLISH_LEVELS;
-}
-
-double tk_tolerance_active(const tk_run *r)
-{
-    double active = r->opt.active_tolerance, h = mean_edge(r);
-    if (h > 0.0)
-        active = fmin(active, ACTIVE_PER_EDGE2 * h * h);
-    return active * polish_scale(r);
-}
-
-double tk_tolerance_kink(const tk_run *r)
-{
-    double active = tk_tolerance_active(r), h = mean_edge(r);
-    if (!(h > 0.0))
-        return active;
-    double stiffness = r->min_radius / r->tau / (h * h);
-    if (stiffness < KINK_STIFFNESS_FROM)
-        return active;
-    return fmax(active, fmin(KINK_TOLERANCE_MOST, active * stiffness));
-}
-
-double tk_tolerance_overstep(const tk_run *r)
-{
-    return fmin(r->opt.overstep_tolerance, tk_tolerance_active(r));
-}
-
-double tk_tolerance_correction(const tk_run *r)
-{
-    return 0.1 * tk_tolerance_overstep(r);
+    return tk_tolerance_from_edge(r) ? POLISH_LEVELS_EDGE : POLISH_LEVELS;
 }
 
 /* The thickness of the starting curve, for set-up. */
@@ -304,11 +194,6 @@ size_t tk_schedule_final_count(const tk_run *r)
     return (size_t)ceil(r->opt.resolution * rope);
 }
 
-bool tk_schedule_final(const tk_run *r)
-{
-    return r->schedule.coarse_level == 0;
-}
-
 /* Everything sized by the curve's vertices: the trial curve, the strut
  * tree and the rooms' vectors; the active set and the warm start are
  * dropped (their edge indices refer to the old curve). */
@@ -324,6 +209,8 @@ int tk_schedule_fit(tk_run *r, tk_error *err)
         rc = tk_motion_fit(r, c->nvert, err);
     if (!rc)
         rc = tk_recovery_fit(r, c->nvert, err);
+    if (!rc)
+        rc = tk_stepping_fit(r, c->nvert, err);
     if (rc)
         return rc;
     free(r->shared.fixed);
@@ -772,7 +659,7 @@ static bool critical_since(const tk_run *r, size_t from)
 static bool stalled(const tk_run *r)
 {
     size_t from = r->schedule.polish_from, window = tk_schedule_window(r, POLISH_WINDOW);
-    double fall, bound = POLISH_CHANGE * polish_scale(r);
+    double fall, bound = POLISH_CHANGE * tk_polish_scale(r);
     if (tk_history_fall(r, from, window, &fall) && fall < bound)
         return true;
     return tk_schedule_final(r) && window >= POLISH_RATE_FROM * POLISH_WINDOW &&
@@ -785,10 +672,10 @@ static bool stalled(const tk_run *r)
  * coarse level moves on at its first stall, unless escapes judge their
  * tries there: then it is polished first, as the final polygon is, and
  * moves on when its last level stalls. */
-void tk_schedule_watch(tk_run *r)
+void tk_schedule_watch(tk_run *r, bool judged_here)
 {
     bool coarse = r->schedule.coarse_level > 0;
-    bool deeper = (!coarse || tk_escape_judged_here(r)) &&
+    bool deeper = (!coarse || judged_here) &&
                   r->schedule.polish_level < polish_levels(r);
     if (!(deeper || coarse) || !(stalled(r) || critical_since(r, r->schedule.polish_from)))
         return;

@@ -1,7 +1,9 @@
 /* Step control (section 4.5): how far the curve moves along the resolved
- * motion, the constraints a step runs into, and the step along the
- * resolved gradient alone when the equalising motion blocks it.  See run.h
- * for the rooms of the flow. */
+ * motion, the constraints a step runs into, the step along the resolved
+ * gradient alone when the equalising motion blocks it, and the retries
+ * with a shorter step when error recovery cannot restore the thickness.
+ * See run.h for the rooms of the flow. */
+#include <stdlib.h>
 #include <string.h>
 
 #include "run.h"
@@ -16,11 +18,33 @@
 #define MAX_HALVINGS 50
 #define MAX_EXPANSIONS 8
 #define HALVINGS_BEFORE_EXPANDING 3
+/* Tries at a step: the step, then up to STEP_ATTEMPTS - 1 shorter ones
+ * when error recovery cannot restore the thickness (tk_stepping_finish). */
+#define STEP_ATTEMPTS 4
 
 void tk_stepping_reset(tk_run *r)
 {
     r->stepping.step_size = 0.0;
     r->stepping.tiny_steps = 0;
+}
+
+void tk_stepping_resume(tk_run *r, double step_size)
+{
+    r->stepping.step_size = step_size;
+}
+
+int tk_stepping_fit(tk_run *r, size_t vertices, tk_error *err)
+{
+    free(r->stepping.held);
+    r->stepping.held = calloc(3 * vertices, sizeof *r->stepping.held);
+    if (!r->stepping.held)
+        return tk_error_set(err, TK_ENOMEM, "out of memory for a run of %zu vertices", vertices);
+    return TK_OK;
+}
+
+void tk_stepping_free(tk_run *r)
+{
+    free(r->stepping.held);
 }
 
 bool tk_stepping_stalled(const tk_run *r)
@@ -126,7 +150,7 @@ static int judge_corrected(tk_run *r, tk_step_report *rep, double h, double meri
 {
     tk_curve *c = r->shared.curve;
     size_t n3 = 3 * c->nvert;
-    double *held = r->recovery.held;
+    double *held = r->stepping.held;
     memcpy(held, c->xyz, n3 * sizeof *c->xyz);
     memcpy(c->xyz, r->shared.trial->xyz, n3 * sizeof *c->xyz);
     int iterations = 0;
@@ -282,7 +306,8 @@ static int take_step(tk_run *r, tk_step_report *rep, bool equalising, double *al
     return TK_OK;
 }
 
-int tk_stepping_step(tk_run *r, tk_step_report *rep, tk_error *err)
+/* Resolves the motion and takes the step (section 4.5). */
+static int step(tk_run *r, tk_step_report *rep, tk_error *err)
 {
     double t0 = tk_clock();
     bool equalising = r->opt.equalise > 0.0;
@@ -306,5 +331,76 @@ int tk_stepping_step(tk_run *r, tk_step_report *rep, tk_error *err)
     r->stepping.tiny_steps =
         rep->step_size < STALL_FRACTION * allowed ? r->stepping.tiny_steps + 1 : 0;
     r->stepping.seconds += tk_clock() - t0;
+    return rc;
+}
+
+/* One attempt at the step: the active set of the run's curve, then the
+ * step along its resolved motion. */
+static int attempt_step(tk_run *r, tk_step_report *rep, tk_error *err)
+{
+    tk_curve *c = r->shared.curve;
+    tk_strut_finder_refit(r->shared.finder, c);
+    int rc = tk_active_find(r, c, &r->active.set, err);
+    if (!rc)
+        rc = step(r, rep, err);
+    return rc;
+}
+
+int tk_stepping_begin(tk_run *r, tk_step_report *rep, tk_error *err)
+{
+    tk_recovery_keep(r);
+    r->stepping.tiny_before = r->stepping.tiny_steps;
+    return attempt_step(r, rep, err);
+}
+
+int tk_stepping_finish(tk_run *r, tk_step_report *rep, int rc, tk_error *err)
+{
+    tk_curve *c = r->shared.curve;
+    for (int attempt = 0;; attempt++) {
+        if (attempt > 0)
+            rc = attempt_step(r, rep, err);
+        double worst = 0.0;
+        if (!rc)
+            rc = tk_recovery_violation(r, c, &worst, err);
+        if (!rc && worst > 0.5 * tk_tolerance_overstep(r)) {
+            int corrections = 0;
+            rc = tk_recovery_correct(r, TK_CORRECTIONS, TK_RESCALE_FEASIBILITY, &corrections,
+                                     err);
+            rep->corrections += corrections;
+        }
+        if (rc != TK_ENUMERIC || !(rep->step_size > 0.0))
+            break;
+        /* Newton steps could not restore the thickness: undo the step,
+         * take one a quarter as long (section 4.5's control doubles the
+         * last step size first, so it starts at half) */
+        tk_recovery_undo(r, true);
+        r->stepping.step_size = 0.25 * rep->step_size;
+        rep->corrections = 0;
+        if (attempt == STEP_ATTEMPTS - 1) {
+            /* No shorter step could be restored either: this step moves
+             * nothing, the next one starts shorter still, and a run of
+             * such steps is a stall (counted from before the attempts,
+             * each of which counted its own step).  The curve as it was
+             * is within the overstep tolerance; when its own violation is
+             * what every step pushes past the point where recovery starts,
+             * and the Newton steps cannot lower it, each step fails the
+             * same way: the trefoil at 4,800 vertices, a kink at 1.745e-6
+             * below the bound (half its overstep tolerance, 3.49e-6), went
+             * 350 s without a step.  So it is corrected, and what the
+             * Newton steps leave rescaled (ropelength does not change
+             * with scale) as at a start; failing that, left as it was. */
+            r->stepping.tiny_steps = r->stepping.tiny_before + 1;
+            rep->step_size = 0.0;
+            int corrections = 0;
+            rc = tk_recovery_correct(r, TK_CORRECTIONS, TK_RESCALE_START(r), &corrections, err);
+            if (rc == TK_ENUMERIC)
+                tk_recovery_undo(r, false);
+            else
+                rep->corrections = corrections;
+            tk_strut_finder_refit(r->shared.finder, c);
+            rc = rc == TK_ENUMERIC ? TK_OK : rc;
+            break;
+        }
+    }
     return rc;
 }

@@ -4,22 +4,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "run.h"
 #include "tk/record.h"
 #include "tk/thickness.h"
-
-/* Tries at a step: the step, then up to STEP_ATTEMPTS - 1 shorter ones
- * when error recovery cannot restore the thickness (see step). */
-#define STEP_ATTEMPTS 4
-
-double tk_clock(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 const char *tk_stop_reason_name(tk_stop_reason r)
 {
@@ -48,31 +36,15 @@ void tk_run_free(tk_run **p)
     free(r->shared.fixed);
     tk_active_free(r);
     tk_motion_free(r);
+    tk_stepping_free(r);
     tk_recovery_free(r);
     tk_escape_free(r);
     free(r->life.history);
     free(r->life.snapshots);
     free(r->life.snapshot_steps);
-    tk_invariants_free(&r->type.start);
-    tk_invariants_free(&r->type.latest);
+    tk_type_free(r);
     free(r);
     *p = NULL;
-}
-
-bool tk_history_fall(const tk_run *r, size_t from, size_t window, double *fall)
-{
-    size_t n = r->life.nhistory;
-    if (window == 0 || n <= from + window)
-        return false;
-    const tk_step_report *h = r->life.history;
-    size_t split = n - window, first = split > from + window ? split - window : from;
-    double before = INFINITY, recent = INFINITY;
-    for (size_t k = first; k < split; k++)
-        before = fmin(before, h[k].ropelength);
-    for (size_t k = split; k < n; k++)
-        recent = fmin(recent, h[k].ropelength);
-    *fall = (before - recent) / recent;
-    return true;
 }
 
 static int record(tk_run *r, tk_step_report *rep, tk_error *err)
@@ -165,28 +137,16 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
     atomic_init(&r->life.cancel, 0);
     /* a resumed run's clock goes on from the time it had spent */
     r->life.started = tk_clock() - (at ? at->seconds : 0.0);
-    r->type.checked_step = -1;
-    r->escape.rng = opts->seed;
-    r->escape.coarse = r->escape.best_coarse = NAN;
-    r->escape.explore_over = at != NULL; /* its exploration's best is not kept */
+    tk_escape_start(r, at != NULL);
     rc = tk_nnls_new(&r->shared.nnls, err);
     if (!rc)
         rc = at ? tk_schedule_resume(r, start, at, err) : tk_schedule_start(r, start, err);
     if (!rc && at)
         rc = tk_escape_resume(r, at, best, best_report, err);
-    if (!rc && start_type) {
-        rc = tk_invariants_copy(start_type, &r->type.start, err);
-    } else if (!rc) {
-        /* the start as given (tk_schedule_start validated it), before
-         * resampling and scaling */
-        double t0 = tk_clock();
-        tk_error why;
-        rc = tk_invariants_compute(start, &r->type.start, &why);
-        r->type.seconds += tk_clock() - t0;
-        if (rc)
-            tk_error_set(err, rc, "the knot or link type of the start cannot be told: %s",
-                         why.message);
-    }
+    /* the start as given (tk_schedule_start validated it), before
+     * resampling and scaling */
+    if (!rc)
+        rc = tk_type_start(r, start, start_type, err);
     if (!rc && (at || r->shared.curve->nvert != start->nvert)) {
         char when[64];
         if (at)
@@ -212,7 +172,7 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
         tk_run_free(&r);
         return rc;
     }
-    r->stepping.step_size = at ? at->step_size : 0.0;
+    tk_stepping_resume(r, at ? at->step_size : 0.0);
     r->life.seconds = tk_clock() - r->life.started;
     *out = r;
     return TK_OK;
@@ -295,22 +255,6 @@ static void check_stop(tk_run *r)
     r->life.stop = stop;
 }
 
-int tk_type_check(tk_run *r, const char *when, tk_error *err)
-{
-    const tk_curve *c = r->shared.curve;
-    double t0 = tk_clock();
-    tk_error why;
-    int rc = tk_invariants_compute(c, &r->type.latest, &why);
-    if (!rc)
-        rc = tk_invariants_compare(&r->type.start, &r->type.latest, &why);
-    r->type.seconds += tk_clock() - t0;
-    r->type.checked_step = r->life.latest.step;
-    r->type.checked_vertices = c->nvert;
-    if (rc)
-        return tk_error_set(err, rc == TK_ETYPE ? TK_ETYPE : rc, "%s: %s", when, why.message);
-    return TK_OK;
-}
-
 /* The figures of the best curve an escape found, put back when the run
  * stopped on another: its active set and forces replace the last step's
  * entry of the history (same step number, step size 0), so the budget
@@ -324,7 +268,7 @@ static int record_restored(tk_run *r, tk_error *err)
         r->life.nsnapshots--;
     tk_curve *c = r->shared.curve;
     tk_strut_finder_refit(r->shared.finder, c);
-    int rc = tk_constraints_copy(&r->active.set, &r->escape.best_set, err);
+    int rc = tk_active_restore(r, &r->escape.best_set, err);
     if (!rc)
         rc = tk_motion_resolve(r, &rep, false, err);
     if (!rc)
@@ -383,60 +327,12 @@ static int step(tk_run *r, tk_error *err)
         r->life.stop = TK_STOP_FAILED;
         return rc;
     }
-    tk_curve *c = r->shared.curve;
-    memcpy(r->recovery.before, c->xyz, 3 * c->nvert * sizeof *c->xyz);
-    int tiny_before = r->stepping.tiny_steps;
-    for (int attempt = 0;; attempt++) {
-        tk_strut_finder_refit(r->shared.finder, c);
-        rc = tk_active_find(r, c, &r->active.set, err);
-        if (!rc)
-            rc = tk_stepping_step(r, &rep, err);
-        if (attempt == 0)
-            tk_schedule_watch(r);
-        double worst = 0.0;
-        if (!rc)
-            rc = tk_recovery_violation(r, c, &worst, err);
-        if (!rc && worst > 0.5 * tk_tolerance_overstep(r)) {
-            int corrections = 0;
-            rc = tk_recovery_correct(r, TK_CORRECTIONS, TK_RESCALE_FEASIBILITY, &corrections,
-                                     err);
-            rep.corrections += corrections;
-        }
-        if (rc != TK_ENUMERIC || !(rep.step_size > 0.0))
-            break;
-        /* Newton steps could not restore the thickness: undo the step,
-         * take one a quarter as long (section 4.5's control doubles the
-         * last step size first, so it starts at half) */
-        memcpy(c->xyz, r->recovery.before, 3 * c->nvert * sizeof *c->xyz);
-        r->stepping.step_size = 0.25 * rep.step_size;
-        r->recovery.undone++;
-        rep.corrections = 0;
-        if (attempt == STEP_ATTEMPTS - 1) {
-            /* No shorter step could be restored either: this step moves
-             * nothing, the next one starts shorter still, and a run of
-             * such steps is a stall (counted from before the attempts,
-             * each of which counted its own step).  The curve as it was
-             * is within the overstep tolerance; when its own violation is
-             * what every step pushes past the point where recovery starts,
-             * and the Newton steps cannot lower it, each step fails the
-             * same way: the trefoil at 4,800 vertices, a kink at 1.745e-6
-             * below the bound (half its overstep tolerance, 3.49e-6), went
-             * 350 s without a step.  So it is corrected, and what the
-             * Newton steps leave rescaled (ropelength does not change
-             * with scale) as at a start; failing that, left as it was. */
-            r->stepping.tiny_steps = tiny_before + 1;
-            rep.step_size = 0.0;
-            int corrections = 0;
-            rc = tk_recovery_correct(r, TK_CORRECTIONS, TK_RESCALE_START(r), &corrections, err);
-            if (rc == TK_ENUMERIC)
-                memcpy(c->xyz, r->recovery.before, 3 * c->nvert * sizeof *c->xyz);
-            else
-                rep.corrections = corrections;
-            tk_strut_finder_refit(r->shared.finder, c);
-            rc = rc == TK_ENUMERIC ? TK_OK : rc;
-            break;
-        }
-    }
+    /* The schedule's polish watch runs after the motion, before error
+     * recovery (which then works to the new tolerances), and on the first
+     * attempt alone: between the halves of the step. */
+    rc = tk_stepping_begin(r, &rep, err);
+    tk_schedule_watch(r, tk_escape_judged_here(r));
+    rc = tk_stepping_finish(r, &rep, rc, err);
     if (!rc)
         rc = figures(r, &rep, err);
     if (rc) {
