@@ -31,6 +31,7 @@
 
 #include "rng.h"
 #include "run.h"
+#include "tk/generate.h"
 #include "tk/thickness.h"
 
 /* Converged: the ropelength fell by less than ESCAPE_CHANGE (relative)
@@ -226,33 +227,10 @@ void tk_escape_reserve(tk_run *r)
                      r->escape.best_report.ropelength < r->life.latest.ropelength);
 }
 
-/* c displaced by the modes coef (per component, ESCAPE_MODES x 2 x 3
- * normals) times amplitude, as a function of arclength. */
-static void deform(tk_curve *c, const tk_curve *from, const double *coef, double amplitude)
-{
-    memcpy(c->xyz, from->xyz, 3 * from->nvert * sizeof *c->xyz);
-    for (size_t comp = 0; comp < c->ncomp; comp++) {
-        const double *a = coef + comp * ESCAPE_MODES * 6;
-        size_t n = tk_curve_comp_vertices(c, comp);
-        double length = tk_curve_comp_length(from, comp), s = 0.0;
-        for (size_t i = 0; i < n; i++) {
-            double phase = 2.0 * M_PI * s / length;
-            double *v = tk_curve_vertex(c, c->offset[comp] + i);
-            bool end = !c->closed[comp] && (i == 0 || i + 1 == n);
-            for (int k = 1; k <= ESCAPE_MODES && !end; k++)
-                for (int d = 0; d < 3; d++)
-                    v[d] += amplitude / k *
-                            (a[(k - 1) * 6 + d] * cos(k * phase) +
-                             a[(k - 1) * 6 + 3 + d] * sin(k * phase));
-            if (i + 1 < n)
-                s += tk_curve_edge_length(from, comp, i);
-        }
-    }
-}
-
 /* The largest deformation of `best` (of the given thickness) that keeps
  * its type and ESCAPE_THICKNESS of its thickness (ESCAPE_FAR_THICKNESS
- * when far), into *out. */
+ * when far), into *out: ESCAPE_MODES modes of normal coefficients
+ * (tk_generate_fourier). */
 static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far, tk_curve **out,
                     double *amplitude, tk_error *err)
 {
@@ -267,7 +245,7 @@ static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far,
     double keep = far ? ESCAPE_FAR_THICKNESS : ESCAPE_THICKNESS;
     bool found = false;
     for (int size = 0; !rc && !found && size < ESCAPE_SIZES; size++, a *= ESCAPE_SHRINK) {
-        deform(*out, best, coef, a);
+        tk_generate_fourier(*out, best, coef, ESCAPE_MODES, a);
         tk_measure m;
         tk_error why;
         if (tk_thickness_measure(*out, NULL, &m, &why) != TK_OK ||

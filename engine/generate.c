@@ -13,9 +13,12 @@
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "rng.h"
 #include "tk/geometry.h"
+#include "tk/invariants.h"
+#include "tk/thickness.h"
 
 /* Counts beyond which a generator refuses: the VECT reader's default
  * limits (TK_VECT_LIMITS_INIT), so that every generated curve reads back. */
@@ -464,4 +467,71 @@ int tk_generate_disguise(const tk_curve *src, unsigned long long seed, double pe
                      2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
     tk_curve_rotate(c, rot);
     return tk_curve_validate(c, err);
+}
+
+void tk_generate_fourier(tk_curve *c, const tk_curve *from, const double *coef, int modes,
+                         double amplitude)
+{
+    memcpy(c->xyz, from->xyz, 3 * from->nvert * sizeof *c->xyz);
+    for (size_t comp = 0; comp < c->ncomp; comp++) {
+        const double *a = coef + comp * (size_t)modes * 6;
+        size_t n = tk_curve_comp_vertices(c, comp);
+        double length = tk_curve_comp_length(from, comp), s = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            double phase = 2.0 * M_PI * s / length;
+            double *v = tk_curve_vertex(c, c->offset[comp] + i);
+            bool end = !c->closed[comp] && (i == 0 || i + 1 == n);
+            for (int k = 1; k <= modes && !end; k++)
+                for (int d = 0; d < 3; d++)
+                    v[d] += amplitude / k *
+                            (a[(k - 1) * 6 + d] * cos(k * phase) +
+                             a[(k - 1) * 6 + 3 + d] * sin(k * phase));
+            if (i + 1 < n)
+                s += tk_curve_edge_length(from, comp, i);
+        }
+    }
+}
+
+int tk_generate_deform(const tk_curve *src, unsigned long long seed, double keep,
+                       tk_curve **out, tk_error *err)
+{
+    *out = NULL;
+    if (!(keep > 0.0 && keep <= 1.0))
+        return tk_error_set(err, TK_EINVAL, "the thickness kept must be in (0, 1] (got %g)", keep);
+    tk_measure m;
+    tk_invariants type = TK_INVARIANTS_INIT, now = TK_INVARIANTS_INIT;
+    size_t ncoef = src->ncomp * TK_DEFORM_MODES * 6;
+    double *coef = malloc(ncoef * sizeof *coef);
+    int rc = coef ? tk_curve_validate(src, err) : tk_error_set(err, TK_ENOMEM, "out of memory");
+    if (!rc)
+        rc = tk_thickness_measure(src, NULL, &m, err);
+    if (!rc)
+        rc = tk_invariants_compute(src, &type, err);
+    if (!rc)
+        rc = tk_curve_copy(src, out, err);
+    uint64_t state = seed;
+    double radius = 0.0;
+    for (size_t i = 0; !rc && i < ncoef; i++)
+        coef[i] = tk_rng_normal(&state);
+    for (size_t comp = 0; !rc && comp < src->ncomp; comp++)
+        radius += tk_curve_comp_length(src, comp) / (2.0 * M_PI) / (double)src->ncomp;
+    bool found = false;
+    for (double a = radius; !rc && !found && a >= 1e-6 * radius; a *= 0.7) {
+        tk_generate_fourier(*out, src, coef, TK_DEFORM_MODES, a);
+        tk_measure d;
+        tk_error why;
+        found = tk_thickness_measure(*out, NULL, &d, &why) == TK_OK &&
+                d.thickness >= keep * m.thickness &&
+                tk_invariants_compute(*out, &now, &why) == TK_OK &&
+                tk_invariants_compare(&type, &now, &why) == TK_OK;
+        tk_invariants_free(&now);
+    }
+    if (!rc && !found)
+        rc = tk_error_set(err, TK_ENUMERIC, "no deformation of seed %llu keeps the type and "
+                          "%g of the thickness", seed, keep);
+    free(coef);
+    tk_invariants_free(&type);
+    if (rc)
+        tk_curve_free(out);
+    return rc;
 }

@@ -148,6 +148,19 @@ expect_status 1 "--vertices 2" "$tk" generate hopf --vertices 2
 expect_status 1 "--vertices over the limit" "$tk" generate borromean --vertices 99999999999
 expect_status 1 "chain 0" "$tk" generate chain 0
 expect_status 1 "hopf with an argument" "$tk" generate hopf 3
+# deform: a start of the file's type, another with another seed
+"$tk" generate torus 2 5 >"$tmp/t25.vect"
+expect_status 0 "deform a file" "$tk" generate deform "$tmp/t25.vect" 4
+cp "$tmp/out" "$tmp/d4.vect"
+"$tk" info "$tmp/t25.vect" | tail -n 1 | sed 's/.* det /det /' >"$tmp/type-a"
+"$tk" info "$tmp/d4.vect" | tail -n 1 | sed 's/.* det /det /' >"$tmp/type-b"
+if cmp -s "$tmp/type-a" "$tmp/type-b" && ! cmp -s "$tmp/t25.vect" "$tmp/d4.vect"; then pass; else
+    fail "deform keeps the type: $(cat "$tmp/type-a") / $(cat "$tmp/type-b")"; fi
+expect_status 1 "deform without a file" "$tk" generate deform
+expect_status 1 "deform with a bad seed" "$tk" generate deform "$tmp/t25.vect" x
+printf 'VECT\n1 2\n' >"$tmp/bad.vect"
+expect_status 2 "deform of a bad file" "$tk" generate deform "$tmp/bad.vect"
+expect_match "bad.vect:2:" "$tmp/err" "deform of a bad file names the line"
 
 # ----------------------------------------------------------- bad input
 

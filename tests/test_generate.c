@@ -9,6 +9,8 @@
 #include "support.h"
 #include "tk/curve.h"
 #include "tk/generate.h"
+#include "tk/invariants.h"
+#include "tk/thickness.h"
 
 static double dist3(const double *a, const double *b)
 {
@@ -410,6 +412,59 @@ START_TEST(lissajous_curve)
 }
 END_TEST
 
+/* A far deformation: the type kept (the Alexander polynomial and linking
+ * numbers computed again here), at least the kept share of the thickness,
+ * measured again; the same seed the same curve, another seed another;
+ * the displacement is the sum of its modes (checked at one vertex by
+ * hand). */
+START_TEST(deform_keeps_type_and_thickness)
+{
+    tk_curve *c = NULL, *d = NULL, *again = NULL, *other = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 5, 120, &c, NULL), TK_OK);
+    tk_measure m, md;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &m, NULL), TK_OK);
+    ck_assert_int_eq(tk_generate_deform(c, 7, 0.05, &d, NULL), TK_OK);
+    ck_assert_int_eq(tk_thickness_measure(d, NULL, &md, NULL), TK_OK);
+    ck_assert(md.thickness >= 0.05 * m.thickness);
+    tk_invariants was = TK_INVARIANTS_INIT, now = TK_INVARIANTS_INIT;
+    ck_assert_int_eq(tk_invariants_compute(c, &was, NULL), TK_OK);
+    ck_assert_int_eq(tk_invariants_compute(d, &now, NULL), TK_OK);
+    ck_assert_int_eq(tk_invariants_compare(&was, &now, NULL), TK_OK);
+    double moved = 0.0;
+    for (size_t k = 0; k < 3 * c->nvert; k++)
+        moved = fmax(moved, fabs(d->xyz[k] - c->xyz[k]));
+    ck_assert(moved > 0.0);
+    ck_assert_int_eq(tk_generate_deform(c, 7, 0.05, &again, NULL), TK_OK);
+    ck_assert_mem_eq(again->xyz, d->xyz, 3 * d->nvert * sizeof *d->xyz);
+    ck_assert_int_eq(tk_generate_deform(c, 8, 0.05, &other, NULL), TK_OK);
+    ck_assert(memcmp(other->xyz, d->xyz, 3 * d->nvert * sizeof *d->xyz) != 0);
+    /* one mode by hand: a_1 = (1, 0, 0), the rest 0, amplitude 0.5; vertex
+     * i sits at the phase of its arclength */
+    double coef[6 * 3] = {1.0};
+    tk_generate_fourier(other, c, coef, 3, 0.5);
+    size_t n = c->nvert, i = n / 3;
+    double before = 0.0, total = 0.0;
+    for (size_t k = 0; k < n; k++) {
+        const double *p = c->xyz + 3 * k, *q = c->xyz + 3 * ((k + 1) % n);
+        double e = sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
+                        (q[2] - p[2]) * (q[2] - p[2]));
+        before += k < i ? e : 0.0;
+        total += e;
+    }
+    double phase = 2.0 * M_PI * before / total;
+    ck_assert_double_eq_tol(other->xyz[3 * i] - c->xyz[3 * i], 0.5 * cos(phase), 1e-12);
+    ck_assert(other->xyz[3 * i + 1] == c->xyz[3 * i + 1]);
+    tk_error err;
+    ck_assert_int_eq(tk_generate_deform(c, 7, 0.0, &again, &err), TK_EINVAL);
+    ck_assert_ptr_null(again);
+    tk_invariants_free(&was);
+    tk_invariants_free(&now);
+    tk_curve_free(&c);
+    tk_curve_free(&d);
+    tk_curve_free(&other);
+}
+END_TEST
+
 static Suite *generate_suite(void)
 {
     Suite *s = suite_create("generate");
@@ -425,6 +480,7 @@ static Suite *generate_suite(void)
     tcase_add_test(tc, chain_rings);
     tcase_add_test(tc, invalid_arguments);
     tcase_add_test(tc, lissajous_curve);
+    tcase_add_test(tc, deform_keeps_type_and_thickness);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -3,6 +3,7 @@
  *   tightknot info [--json] [--tolerance EPS] FILE...
  *   tightknot struts [--json] [--tolerance EPS] FILE
  *   tightknot generate torus P Q | figure-eight | lissajous NX NY NZ | hopf | borromean | chain K
+ *                      | deform FILE [SEED]
  *                      [--vertices N] [--disguise SEED]
  *   tightknot tighten FILE [run options] [-o OUT] [--struts OUT] [--log OUT]
  *                    [--snapshots DIR --every K] [--json]
@@ -175,6 +176,12 @@ static const char generate_help[] =
     "              thickness 1: ropelength 8 pi); N is rounded up to even\n"
     "  borromean   the Borromean rings: three perpendicular ellipses with\n"
     "              semi-axes 2 and 1\n"
+    "  deform FILE [SEED]\n"
+    "              a start of another shape with FILE's type: the largest\n"
+    "              smooth random deformation (three Fourier modes along\n"
+    "              each component, drawn from SEED, default 1) that keeps\n"
+    "              FILE's knot or link type and a twentieth of its\n"
+    "              thickness ('-': standard input)\n"
     "  chain K     K >= 1 rings of radius 1, centres 1.5 apart on the x axis,\n"
     "              in alternating planes, each linked with its neighbours\n"
     "\n"
@@ -686,6 +693,11 @@ static int cmd_struts(int argc, char **argv)
     return status;
 }
 
+/* generate deform: the thickness a far deformation keeps, as the escapes'
+ * far tries do (engine/escape.c): loose enough that its tightening can
+ * find another basin than the file's. */
+#define DEFORM_KEEP 0.05
+
 /* Builds the curve a generate command line asks for; EXIT_USAGE with a
  * message when the shape or its arguments are wrong. */
 static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
@@ -693,7 +705,7 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
     const char *cmd = "generate";
     if (npos == 0)
         return usage_error(cmd, "no SHAPE given (torus P Q, figure-eight, lissajous NX NY NZ, "
-                                "hopf, borromean or chain K)");
+                                "hopf, borromean, chain K or deform FILE)");
     const char *shape = pos[0];
     tk_error err;
     tk_error_clear(&err);
@@ -729,6 +741,21 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
             freq[k] = (int)f;
         }
         rc = tk_generate_lissajous(freq, phase, vertices, out, &err);
+    } else if (strcmp(shape, "deform") == 0) {
+        if (npos != 2 && npos != 3)
+            return usage_error(cmd, "deform takes a FILE and optionally a SEED");
+        long long seed = 1;
+        if (npos == 3 && parse_integer(cmd, "deform SEED", pos[2], 0, 1LL << 53, &seed))
+            return EXIT_USAGE;
+        tk_curve *src = NULL;
+        rc = tk_vect_read_file(input_path(pos[1]), NULL, &src, &err);
+        if (!rc)
+            rc = tk_generate_deform(src, (unsigned long long)seed, DEFORM_KEEP, out, &err);
+        tk_curve_free(&src);
+        if (rc == TK_EPARSE || rc == TK_EIO) {
+            report(NULL, &err);
+            return EXIT_INPUT;
+        }
     } else if (strcmp(shape, "chain") == 0) {
         if (npos != 2)
             return usage_error(cmd, "chain takes one argument, K");
@@ -739,7 +766,7 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
     } else {
         return usage_error(cmd,
                            "unknown shape '%s' (torus P Q, figure-eight, lissajous NX NY NZ, "
-                           "hopf, borromean or chain K)",
+                           "hopf, borromean, chain K or deform FILE)",
                            shape);
     }
     if (rc == TK_EINVAL || rc == TK_ELIMIT)

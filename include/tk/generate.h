@@ -62,4 +62,26 @@ int tk_generate_lissajous(const int freq[3], const double phase[3], size_t verti
 int tk_generate_disguise(const tk_curve *src, unsigned long long seed, double perturbation,
                          tk_curve **out, tk_error *err);
 
+/* A smooth displacement of `from` into c (same counts): every vertex
+ * (but an open component's ends) moved by the sum over k = 1..modes of
+ * amplitude / k (a_k cos(k phi) + b_k sin(k phi)), phi = 2 pi s / L the
+ * phase of its arclength s along its component of length L; component
+ * j's vectors a_1, b_1, a_2, ... are coef[j * modes * 6 ...], three
+ * coordinates each.  Strands near each other move together, so a few
+ * modes reshape the curve without passing it through itself at once. */
+void tk_generate_fourier(tk_curve *c, const tk_curve *from, const double *coef, int modes,
+                         double amplitude);
+
+/* A start of another shape with src's type: the largest smooth
+ * displacement (tk_generate_fourier, TK_DEFORM_MODES modes, normal
+ * coefficients drawn from `seed`) that keeps src's knot or link type and
+ * at least `keep` (in (0, 1]) of its thickness.  Its amplitude starts at
+ * the mean radius of src's components taken as circles (L / 2 pi) and
+ * shrinks by 0.7 until both hold: far from src at once, where the
+ * strands leave room.  TK_ENUMERIC when no amplitude down to 1e-6 of the
+ * start does. */
+#define TK_DEFORM_MODES 3
+int tk_generate_deform(const tk_curve *src, unsigned long long seed, double keep,
+                       tk_curve **out, tk_error *err);
+
 #endif
