@@ -42,6 +42,7 @@ typedef struct edge_frame {
     double mid[3];  /* midpoint */
     double dir[3];  /* unit direction (0 for an edge of length 0) */
     double half;    /* half its length */
+    double round;   /* the rounding of a distance to it: 64 eps of its extent */
 } edge_frame;
 
 typedef struct tree_node {
@@ -49,6 +50,7 @@ typedef struct tree_node {
     size_t first, end;  /* global edge range [first, end) */
     size_t left, right; /* children, 0 for a leaf (the root is node 0) */
     size_t comp;        /* the component when the range lies in one */
+    double extent;      /* the largest coordinate magnitude in the box */
 } tree_node;
 
 struct tk_strut_finder {
@@ -241,6 +243,7 @@ void tk_strut_finder_refit(tk_strut_finder *f, const tk_curve *c)
                 n->lo[k] = fmin(l->lo[k], r->lo[k]);
                 n->hi[k] = fmax(l->hi[k], r->hi[k]);
             }
+            n->extent = l->extent > r->extent ? l->extent : r->extent;
             continue;
         }
         for (int k = 0; k < 3; k++) {
@@ -260,7 +263,14 @@ void tk_strut_finder_refit(tk_strut_finder *f, const tk_curve *c)
             for (int k = 0; k < 3; k++)
                 fr->dir[k] = len > 0.0 ? fr->dir[k] / len : 0.0;
             fr->half = 0.5 * len;
+            double far = 0.0;
+            for (int k = 0; k < 3; k++)
+                far = fmax(far, fabs(fr->mid[k]));
+            fr->round = 64.0 * DBL_EPSILON * (far + fr->half);
         }
+        n->extent = 0.0;
+        for (int k = 0; k < 3; k++)
+            n->extent = fmax(n->extent, fmax(fabs(n->lo[k]), fabs(n->hi[k])));
     }
 }
 
@@ -477,11 +487,7 @@ static bool pair_beyond(const tk_strut_finder *f, size_t i, size_t j, double bou
      * edges far from the origin would be pruned while their closest
      * points (which tk_segment_closest gets to eps of the coordinates)
      * lie within the bound. */
-    double scale = sqrt(ww) + a->half + b->half;
-    double coords = 0.0;
-    for (int k = 0; k < 3; k++)
-        coords = fmax(coords, fmax(fabs(a->mid[k]), fabs(b->mid[k])));
-    double reach = bound + 1e-7 * scale + 64.0 * DBL_EPSILON * (coords + scale);
+    double reach = bound + 1e-7 * (sqrt(ww) + a->half + b->half) + a->round + b->round;
     double r2 = reach * reach;
     double along = fmax(fabs(wu) - a->half - b->half * fabs(cu), 0.0);
     if (along * along > r2)
@@ -547,16 +553,6 @@ static double box_gap2(const tree_node *x, const tree_node *y)
     return g2;
 }
 
-/* The largest coordinate magnitude in either box. */
-static double boxes_extent(const tree_node *x, const tree_node *y)
-{
-    double m = 0.0;
-    for (int k = 0; k < 3; k++)
-        m = fmax(m, fmax(fmax(fabs(x->lo[k]), fabs(x->hi[k])),
-                         fmax(fabs(y->lo[k]), fabs(y->hi[k]))));
-    return m;
-}
-
 static bool node_pair_pruned(const query *qy, const tree_node *x, const tree_node *y)
 {
     double g2 = box_gap2(x, y);
@@ -564,7 +560,7 @@ static bool node_pair_pruned(const query *qy, const tree_node *x, const tree_nod
      * tk_segment_closest is exact only to eps of the coordinates, so a
      * pair just beyond the bound may measure within it: pruned only
      * beyond that rounding. */
-    double reach = qy->bound + 64.0 * DBL_EPSILON * boxes_extent(x, y);
+    double reach = qy->bound + 64.0 * DBL_EPSILON * (x->extent > y->extent ? x->extent : y->extent);
     double b2 = reach * reach;
     if (qy->shortest_mode ? g2 >= b2 : g2 > b2)
         return true;
