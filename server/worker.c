@@ -164,9 +164,14 @@ static int flush(job_run *jr, const json_t *end, tk_error *err)
         rc = tk_record_parts(jr->run, jr->before, jr->pool->cfg.history, parts, err);
     json_t *type = jr->run || jr->refused.ncomp || jr->input_type.ncomp ? invariants_json(jr)
                                                                          : NULL;
+    size_t ne = 0;
+    const tk_escape *e = jr->run ? tk_run_escapes(jr->run, &ne) : NULL;
+    json_t *basins = jr->run ? tk_json_basins(e, ne, tk_run_latest(jr->run)->ropelength) : NULL;
     pthread_mutex_lock(&jr->pool->lock);
     if (type)
         json_object_set_new(jr->slot->doc, "invariants", type);
+    if (basins)
+        json_object_set_new(jr->slot->doc, "basins", basins);
     pthread_mutex_unlock(&jr->pool->lock);
     if (!rc)
         rc = put(jr, parts, end, err);

@@ -217,6 +217,9 @@ describe('catalogue knot 3.1, resolution 5, 300 steps', () => {
         assert.equal(queued.name, '3.1');
         const job = await waitFinal(d, queued.id);
         assertSameFigures(job, cli.summary);
+        // how sure the run is: the same basins as the command line's
+        assert.deepEqual(job.basins, cli.summary.basins);
+        assert.ok(job.basins.basins[0].ropelength >= job.ropelength);
         assert.ok(job.started <= job.finished && job.created <= job.started);
         await assertSameStruts(job, cli);
         const curve = await assertSameCurve(job, cli);
