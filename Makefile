@@ -88,7 +88,7 @@ BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
 .SECONDARY:
 
-.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-starts bench-service bench-cluster \
+.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-starts bench-service bench-cluster bench-catalogue \
 	lint headers clean fuzz fuzz-bin
 
 WEB_OUT := $(BUILD)/web
@@ -218,6 +218,10 @@ bench-service: deps all
 
 bench-cluster: deps all
 	$(Q)node bench/cluster.mjs $(BUILD) $(CATALOGUE)
+
+# The whole catalogue through the service (hours: see README, --slice).
+bench-catalogue: deps all
+	$(Q)node bench/catalogue.mjs --build $(BUILD) $(CATALOGUE)
 
 # Banned unsafe calls (curl's list); and each engine file calls only those
 # below it (engine/run.h's order), read from the objects' symbols.

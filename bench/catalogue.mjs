@@ -1,0 +1,307 @@
+// bench/catalogue.mjs: the whole catalogue through the service, each knot
+// and link from several starts, the way a user would run it: a daemon
+// (its own, or one given with --server) and `tightknot remote submit`.
+//
+// For each knot or link of the slice it makes starts of different shapes
+// with the catalogue file's type (checked with `tightknot info` before
+// any is submitted): the catalogue file itself, far deformations of it
+// (`tightknot generate deform`, one per seed), and the parametric forms
+// whose type is the file's (torus knots and links, chains).  They are
+// tightened with the same settings; the results land in OUT/results
+// (the client's summary.tsv and one VECT and contacts file a start), and
+// the table of every knot done so far, over every slice run into OUT, is
+// written to TABLE: its type, the ropelength of each start, the lowest,
+// the spread between starts, the struts and kinks and seconds of the
+// lowest, the settings.  Then a summary: how many knots have every start
+// within 0.1% of their lowest, the widest spreads, how often the
+// catalogue's own start was the one trapped, and by how much.
+//
+// It resumes: run again, it submits only the starts without a result
+// (the client's own resume); its daemon's store keeps the jobs of a run
+// that was stopped, which the next run's daemon takes up again.  A slice
+// K/N takes every N-th knot from the K-th, so the table fills over runs.
+// Prints figures; never fails on time.
+//
+// usage: node bench/catalogue.mjs [options] [CATALOGUE_DIR]
+//   --server URL      a running daemon (default: one of its own, its store
+//                     OUT/jobs.db, one worker per core)
+//   --token TOKEN     for a daemon with --tokens
+//   --slice K/N       the K-th of N slices (default 1/1: all)
+//   --seconds S       wall time per start (default 60)
+//   --resolution R    vertices per unit ropelength (default 5)
+//   --far K           far deformations per knot, seeds 1..K (default 2)
+//   --parallel N      starts running at once (default: the cores)
+//   --out DIR         work directory (default build/catalogue)
+//   --table FILE      the table (default docs/catalogue.tsv)
+//   --build DIR       the programs (default build)
+//   --only NAME,...   these knots only (a check of a few)
+//   --table-only      write the table and summary from OUT, submit nothing
+
+import { execFileSync, spawn, spawnSync } from 'node:child_process';
+import { existsSync, mkdirSync, readdirSync, readFileSync, writeFileSync } from 'node:fs';
+import { cpus } from 'node:os';
+import { join, resolve } from 'node:path';
+
+const argv = process.argv.slice(2);
+const opt = {
+    server: null, token: process.env.TIGHTKNOT_TOKEN ?? null, slice: '1/1', seconds: 60,
+    resolution: 5, far: 2, parallel: cpus().length, out: 'build/catalogue',
+    table: 'docs/catalogue.tsv', build: 'build', only: null, tableOnly: false,
+    catalogue: '../shared/catalogue',
+};
+for (let i = 0; i < argv.length; i++) {
+    const a = argv[i];
+    const value = () => {
+        if (i + 1 >= argv.length) usage(`${a} needs a value`);
+        return argv[++i];
+    };
+    if (a === '--server') opt.server = value();
+    else if (a === '--token') opt.token = value();
+    else if (a === '--slice') opt.slice = value();
+    else if (a === '--seconds') opt.seconds = Number(value());
+    else if (a === '--resolution') opt.resolution = Number(value());
+    else if (a === '--far') opt.far = Number(value());
+    else if (a === '--parallel') opt.parallel = Number(value());
+    else if (a === '--out') opt.out = value();
+    else if (a === '--table') opt.table = value();
+    else if (a === '--build') opt.build = value();
+    else if (a === '--only') opt.only = value().split(',');
+    else if (a === '--table-only') opt.tableOnly = true;
+    else if (a === '-h' || a === '--help') usage(null);
+    else if (a.startsWith('-')) usage(`unknown option ${a}`);
+    else opt.catalogue = a;
+}
+const slice = /^(\d+)\/(\d+)$/.exec(opt.slice);
+if (!slice || +slice[1] < 1 || +slice[1] > +slice[2]) usage(`--slice ${opt.slice}: expected K/N, 1 <= K <= N`);
+for (const k of ['seconds', 'resolution', 'parallel'])
+    if (!(opt[k] > 0)) usage(`--${k} must be positive`);
+if (!(Number.isInteger(opt.far) && opt.far >= 0)) usage('--far must be a whole number >= 0');
+
+function usage(why) {
+    const text = readFileSync(new URL(import.meta.url), 'utf8').split('\n');
+    const from = text.findIndex((l) => l.startsWith('// usage:'));
+    const help = text.slice(from, text.findIndex((l, k) => k > from && !l.startsWith('//')))
+        .map((l) => l.replace(/^\/\/ ?/, '')).join('\n');
+    if (why) console.error(`bench/catalogue: ${why}`);
+    (why ? console.error : console.log)(help);
+    process.exit(why ? 1 : 0);
+}
+
+const CLI = resolve(opt.build, 'tightknot');
+const DAEMON = resolve(opt.build, 'tightknotd');
+for (const p of [CLI, DAEMON])
+    if (!existsSync(p)) usage(`${p} is missing: build it with make`);
+const out = resolve(opt.out);
+const startsDir = join(out, 'starts');
+const resultsDir = join(out, 'results');
+mkdirSync(startsDir, { recursive: true });
+mkdirSync(resultsDir, { recursive: true });
+
+// ---- the knots and their types
+
+const natural = (a, b) => a.localeCompare(b, 'en', { numeric: true });
+const knots = readdirSync(opt.catalogue)
+    .filter((f) => /^\d+(\.\d+){1,2}\.vect$/.test(f))
+    .map((f) => f.slice(0, -5))
+    .sort(natural);
+const mine = knots.filter((n, k) => k % +slice[2] === +slice[1] - 1 && (!opt.only || opt.only.includes(n)));
+
+const info = (file) => JSON.parse(execFileSync(CLI, ['info', '--json', file], { encoding: 'utf8' }));
+// The type as compared: Alexander polynomials, determinants and linking
+// numbers up to sign (a mirror or a reversed component has the same
+// ropelength).
+const typeKey = (inv) => JSON.stringify([inv.alexander, inv.determinants,
+    inv.linking.map((row) => row.map(Math.abs))]);
+const typeText = (inv) => `det ${inv.determinants.join(',')}; ${inv.alexander_text.join(', ')}` +
+    (inv.linking.length > 1 ? `; lk ${inv.linking.map((r) => r.join(' ')).join(' / ')}` : '');
+
+// The parametric forms worth trying for a name K.N or K.C.N (crossings K,
+// C components): whichever of them has the file's type is a start.
+function parametric(name) {
+    const [k, c] = name.split('.').map(Number);
+    const comps = name.split('.').length === 3 ? c : 1;
+    const tries = [];
+    if (comps === 1 && k % 2 === 1) tries.push(['torus', '2', String(k)]);
+    if (comps === 2 && k % 2 === 0) tries.push(['torus', '2', String(k)]);
+    if (k === 8 && comps === 1) tries.push(['torus', '3', '4']);
+    if (k === 10 && comps === 1) tries.push(['torus', '3', '5']);
+    if (k === 6 && comps === 3) tries.push(['torus', '3', '3']);
+    if (k === 8 && comps === 4) tries.push(['torus', '4', '4']);
+    if (comps > 1 && k === 2 * (comps - 1)) tries.push(['chain', String(comps)]);
+    return tries;
+}
+
+// Makes the starts of one knot (those not made yet); returns their files.
+function makeStarts(name) {
+    const file = join(opt.catalogue, `${name}.vect`);
+    const typeFile = join(startsDir, `${name}.type.json`);
+    let want;
+    if (existsSync(typeFile)) {
+        want = JSON.parse(readFileSync(typeFile, 'utf8'));
+    } else {
+        want = info(file).invariants;
+        writeFileSync(typeFile, JSON.stringify(want));
+    }
+    const files = [];
+    const put = (tag, text, why) => {
+        const path = join(startsDir, `${name}@${tag}.vect`);
+        if (!existsSync(path)) {
+            writeFileSync(path + '.part', text);
+            const got = info(path + '.part').invariants;
+            if (typeKey(got) !== typeKey(want)) {
+                console.log(`  ${name}: the ${why} is of another type (${typeText(got)}), not a start`);
+                return;
+            }
+            execFileSync('mv', [path + '.part', path]);
+        }
+        files.push(path);
+    };
+    put('cat', readFileSync(file, 'utf8'), 'catalogue file');
+    for (let s = 1; s <= opt.far; s++) {
+        const r = spawnSync(CLI, ['generate', 'deform', file, String(s)], { encoding: 'utf8' });
+        if (r.status === 0) put(`far${s}`, r.stdout, `deformation ${s}`);
+        else console.log(`  ${name}: no deformation ${s}: ${r.stderr.trim()}`);
+    }
+    for (const p of parametric(name)) {
+        const r = spawnSync(CLI, ['generate', ...p], { encoding: 'utf8' });
+        if (r.status === 0) {
+            const got = spawnSync(CLI, ['info', '--json', '-'], { input: r.stdout, encoding: 'utf8' });
+            if (got.status === 0 && typeKey(JSON.parse(got.stdout).invariants) === typeKey(want))
+                put(p.join(''), r.stdout, p.join(' '));
+        }
+    }
+    return files;
+}
+
+// ---- the daemon and the client
+
+async function ownDaemon() {
+    const proc = spawn(DAEMON, ['--port', '0', '--db', join(out, 'jobs.db'),
+        '--workers', String(opt.parallel), '--max-per-address', '1000'], { stdio: ['ignore', 'pipe', 'inherit'] });
+    const port = await new Promise((res, rej) => {
+        let text = '';
+        proc.stdout.setEncoding('utf8').on('data', (d) => {
+            text += d;
+            const m = /listening on http:\/\/127\.0\.0\.1:(\d+)\//.exec(text);
+            if (m) res(Number(m[1]));
+        });
+        proc.on('exit', (code) => rej(new Error(`tightknotd exited (${code}) before listening: ${text}`)));
+    });
+    return { url: `http://127.0.0.1:${port}`, proc };
+}
+
+async function submitAll(server, files) {
+    // autoscale: a deformed start is thinner than the tube (ropelength
+    // does not depend on the scale)
+    const args = ['remote', '--server', server, 'submit', '--resolution', String(opt.resolution),
+        '--time', String(opt.seconds), '--autoscale', '--parallel', String(opt.parallel),
+        '--out', resultsDir, ...files];
+    if (opt.token) args.splice(3, 0, '--token', opt.token);
+    const child = spawn(CLI, args, { stdio: 'inherit' });
+    return new Promise((res) => child.on('exit', (code) => res(code)));
+}
+
+// ---- the table
+
+function readSummary() {
+    const path = join(resultsDir, 'summary.tsv');
+    const rows = new Map();
+    if (!existsSync(path)) return rows;
+    for (const line of readFileSync(path, 'utf8').split('\n')) {
+        const f = line.split('\t');
+        if (f.length < 10 || f[0] === 'name') continue;
+        const [name, components, vertices, ropelength, thickness, residual, struts, steps, seconds, state] = f;
+        rows.set(name, { name, components: +components, vertices: +vertices, ropelength: +ropelength,
+            struts: +struts, steps: +steps, seconds: +seconds, state });
+    }
+    return rows;
+}
+
+function kinksOf(start) {
+    try {
+        const doc = JSON.parse(readFileSync(join(resultsDir, `${start}.struts.json`), 'utf8'));
+        return doc.kinks?.length ?? '';
+    } catch {
+        return '';
+    }
+}
+
+function writeTable() {
+    const rows = readSummary();
+    const byKnot = new Map();
+    for (const r of rows.values()) {
+        const at = r.name.lastIndexOf('@');
+        if (at < 0) continue;
+        const knot = r.name.slice(0, at);
+        if (!byKnot.has(knot)) byKnot.set(knot, []);
+        byKnot.get(knot).push({ ...r, tag: r.name.slice(at + 1) });
+    }
+    const settings = `resolution ${opt.resolution}, ${opt.seconds} s a start, autoscale, default escapes`;
+    const lines = [['name', 'components', 'type', 'vertices', 'starts', 'lowest', 'lowest.start',
+        'spread.%', 'cat.above.%', 'struts', 'kinks', 'seconds', 'failed', 'settings'].join('\t')];
+    const summary = { knots: 0, compared: 0, agree: 0, spreads: [], catTrapped: [], failed: [] };
+    for (const knot of [...byKnot.keys()].sort(natural)) {
+        const starts = byKnot.get(knot).sort((a, b) => natural(a.tag, b.tag));
+        const ok = starts.filter((s) => s.state === 'done' && Number.isFinite(s.ropelength));
+        const failed = starts.filter((s) => s.state !== 'done');
+        for (const s of failed) summary.failed.push(`${knot}@${s.tag}: ${s.state}`);
+        if (!ok.length) continue;
+        const best = ok.reduce((a, b) => (b.ropelength < a.ropelength ? b : a));
+        const worst = ok.reduce((a, b) => (b.ropelength > a.ropelength ? b : a));
+        const spread = 100 * (worst.ropelength - best.ropelength) / best.ropelength;
+        const cat = ok.find((s) => s.tag === 'cat');
+        const catAbove = cat ? 100 * (cat.ropelength - best.ropelength) / best.ropelength : NaN;
+        let type = '';
+        try {
+            type = typeText(JSON.parse(readFileSync(join(startsDir, `${knot}.type.json`), 'utf8')));
+        } catch { /* made by another out directory */ }
+        lines.push([knot, best.components, type, best.vertices,
+            ok.map((s) => `${s.tag}=${s.ropelength.toFixed(6)}`).join(' '), best.ropelength.toFixed(6),
+            best.tag, spread.toFixed(4), Number.isFinite(catAbove) ? catAbove.toFixed(4) : '',
+            best.struts, kinksOf(`${knot}@${best.tag}`),
+            ok.reduce((t, s) => t + s.seconds, 0).toFixed(0), failed.length, settings].join('\t'));
+        summary.knots++;
+        if (ok.length > 1) summary.compared++;
+        if (ok.length > 1 && spread <= 0.1) summary.agree++;
+        summary.spreads.push([spread, knot, best.tag, best.ropelength, worst.tag, worst.ropelength]);
+        if (catAbove > 0.1) summary.catTrapped.push([catAbove, knot]);
+    }
+    mkdirSync(resolve(opt.table, '..'), { recursive: true });
+    writeFileSync(opt.table, lines.join('\n') + '\n');
+    const pct = (n) => (summary.knots ? (100 * n / summary.knots).toFixed(1) : '-');
+    console.log(`table: ${opt.table}, ${summary.knots} of ${knots.length} knots and links (${settings})`);
+    console.log(`  with two starts or more: ${summary.compared}; every start within 0.1% of the lowest: ` +
+        `${summary.agree} (${summary.compared ? (100 * summary.agree / summary.compared).toFixed(1) : '-'}%)`);
+    console.log(`  the catalogue's start more than 0.1% above the lowest: ${summary.catTrapped.length} ` +
+        `(${pct(summary.catTrapped.length)}%)` + (summary.catTrapped.length
+        ? `, by ${Math.min(...summary.catTrapped.map((t) => t[0])).toFixed(2)}% to ` +
+          `${Math.max(...summary.catTrapped.map((t) => t[0])).toFixed(2)}%` : ''));
+    const widest = summary.spreads.sort((a, b) => b[0] - a[0]).slice(0, 10).filter((s) => s[0] > 0.1);
+    for (const [spread, knot, lo, lov, hi, hiv] of widest)
+        console.log(`  ${knot}: ${spread.toFixed(3)}% apart (${lo} ${lov.toFixed(4)}, ${hi} ${hiv.toFixed(4)})`);
+    for (const f of summary.failed) console.log(`  failed: ${f}`);
+}
+
+// ---- the run
+
+if (!opt.tableOnly) {
+    console.log(`bench/catalogue: slice ${opt.slice}, ${mine.length} of ${knots.length} knots and links; ` +
+        `starts in ${startsDir}`);
+    const files = [];
+    for (const name of mine) files.push(...makeStarts(name));
+    console.log(`bench/catalogue: ${files.length} starts; resolution ${opt.resolution}, ${opt.seconds} s each, ` +
+        `${opt.parallel} at once`);
+    let daemon = null;
+    const server = opt.server ?? (daemon = await ownDaemon()).url;
+    const t0 = Date.now();
+    const code = await submitAll(server, files);
+    console.log(`bench/catalogue: the client ended (exit ${code}) after ${((Date.now() - t0) / 1000).toFixed(0)} s`);
+    if (daemon) {
+        const metrics = await fetch(`${server}/metrics`).then((r) => r.text()).catch(() => '');
+        for (const line of metrics.split('\n'))
+            if (/^tightknot_(jobs|workers|worker)/.test(line)) console.log(`  ${line}`);
+        daemon.proc.kill('SIGTERM');
+        await new Promise((r) => daemon.proc.on('exit', r));
+    }
+}
+writeTable();
