@@ -52,9 +52,9 @@ int tk_tokens_load(const char *path, tk_tokens **out, tk_error *err)
                               "sha256:HEX' (64 hex digits; a name of at most 62 bytes, a token of at most 510), "
                               "then optionally 'admin'", path, no);
         else if (!hashed && strlen(token) < TK_TOKEN_MIN)
-            rc = tk_error_set(err, TK_EPARSE, "%s:%ld: the token is %zu characters; a token "
-                              "needs at least %d, or one a client could guess", path, no,
-                              strlen(token), TK_TOKEN_MIN);
+            rc = tk_error_set(err, TK_EPARSE, "%s:%ld: the token has %zu character%s; a token "
+                              "needs at least %d, or a client could guess it", path, no,
+                              strlen(token), strlen(token) == 1 ? "" : "s", TK_TOKEN_MIN);
         else if (!hashed && gnutls_hash_fast(GNUTLS_DIG_SHA256, token, strlen(token), e.hash))
             rc = tk_error_set(err, TK_EIO, "--tokens: cannot hash a token");
         else if (!(grown = realloc(t->e, (t->n + 1) * sizeof *grown)))
