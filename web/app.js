@@ -72,6 +72,19 @@ function showType(inv) {
         : changed ? `the start's type → the result's: ${start} → ${result}` : `start and result: ${result}`;
 }
 
+// The basins the run's tightenings reached (job.basins), lowest first,
+// each with how often: "71.0012 ×2, 71.1281 ×1"; the note when the lowest
+// was reached once.
+function showBasins(b) {
+    const dd = $('fig-basins');
+    const list = b?.basins ?? [];
+    dd.textContent = list.length
+        ? list.map((x) => `${Number(x.ropelength).toFixed(4)} ×${x.reached}`).join(', ') : '–';
+    dd.classList.toggle('once', b?.note != null);
+    dd.title = b?.note ? `the lowest ${b.note}`
+        : list.length ? `the lowest reached ${b.best_reached} times` : 'not known before the run has stored its figures';
+}
+
 function fileName(job, ext) {
     const base = (job.name || 'job').replace(/[^A-Za-z0-9._-]+/g, '_');
     return `${base}-${job.id}${ext}`;
@@ -470,6 +483,7 @@ function showJob(job) {
     $('fig-vertices').textContent = job.vertices;
     $('fig-seconds').textContent = job.seconds == null ? '–' : `${job.seconds.toFixed(1)} s`;
     showType(job.invariants);
+    showBasins(job.basins);
     const frac = job.progress.fraction ?? (job.state === 'done' ? 1 : 0);
     $('job-progress').style.width = `${(100 * frac).toFixed(1)}%`;
 }
