@@ -32,13 +32,17 @@ static double project(const double *x, const double *a0, const double *d, double
     return clamp01(tk_dot3(r, d) / dd);
 }
 
-static bool snap(double *s)
+/* Snaps s (on an edge of squared length dd, at distance dist from the
+ * other edge) onto an end point within TK_SNAP_PARAMETER of it, scaled
+ * down where the edge is longer than the distance (geometry.h). */
+static bool snap(double *s, double dd, double dist)
 {
-    if (*s < TK_SNAP_PARAMETER) {
+    double limit = dd > dist * dist ? TK_SNAP_PARAMETER * dist / sqrt(dd) : TK_SNAP_PARAMETER;
+    if (*s < limit) {
         *s = 0.0;
         return true;
     }
-    if (*s > 1.0 - TK_SNAP_PARAMETER) {
+    if (*s > 1.0 - limit) {
         *s = 1.0;
         return true;
     }
@@ -121,15 +125,15 @@ void tk_segment_closest(const double a0[3], const double a1[3],
     /* Snap parameters next to an end point onto it, then let the other
      * parameter follow, so that a contact at a shared vertex is seen the
      * same (bit for bit) from both edges at that vertex. */
-    bool snapped_s = snap(&best_s), snapped_t = snap(&best_t);
+    bool snapped_s = snap(&best_s, a, best), snapped_t = snap(&best_t, e, best);
     if (snapped_s && !snapped_t) {
         point_at(a0, d1, best_s, p);
         best_t = project(p, b0, d2, e);
-        snap(&best_t);
+        snap(&best_t, e, best);
     } else if (snapped_t && !snapped_s) {
         point_at(b0, d2, best_t, q);
         best_s = project(q, a0, d1, a);
-        snap(&best_s);
+        snap(&best_s, a, best);
     }
     /* End points are taken exactly, not recomputed as a0 + 1 * d. */
     if (best_s == 0.0)

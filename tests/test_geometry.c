@@ -144,6 +144,30 @@ START_TEST(segment_distance_exact_cases)
 }
 END_TEST
 
+/* A closest point 5e-8 of its parameter from the end of an edge 6e7 long
+ * is 3 units from that end: snapping it there (the snap once took any
+ * parameter within 1e-7) measured a pair 0.002 apart as 3 apart, and the
+ * flow passed a strand through another (a fuzzed curve, in
+ * tests/fuzz/corpus/flow).  Exact: the short edge is the segment of the z
+ * axis in [-1, 1], the long one the line y = 0.002, z = 0 from x = -3. */
+START_TEST(long_edge_keeps_its_closest_point)
+{
+    double a0[3] = {0, 0, -1}, a1[3] = {0, 0, 1};
+    double b0[3] = {-3, 0.002, 0}, b1[3] = {6e7 - 3, 0.002, 0};
+    tk_closest c;
+    tk_segment_closest(a0, a1, b0, b1, &c);
+    ck_assert_double_eq_tol(c.dist, 0.002, 1e-12);
+    ck_assert_double_eq_tol(c.t, 3.0 / 6e7, 1e-15);
+    ck_assert_double_eq_tol(c.s, 0.5, 1e-12);
+    tk_segment_closest(b0, b1, a0, a1, &c);
+    ck_assert_double_eq_tol(c.dist, 0.002, 1e-12);
+    /* an edge shorter than the distance still snaps within 1e-7 */
+    double e0[3] = {-1e-8, 1, 0}, e1[3] = {1 - 1e-8, 1, 0};
+    tk_segment_closest(a0, a1, e0, e1, &c);
+    ck_assert(c.t == 0.0 && c.q[0] == e0[0]);
+}
+END_TEST
+
 START_TEST(distance_gradient_matches_finite_differences)
 {
     tkt_rng r = {7};
@@ -334,6 +358,7 @@ int main(void)
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, segment_distance_matches_sampling);
     tcase_add_test(tc, segment_distance_exact_cases);
+    tcase_add_test(tc, long_edge_keeps_its_closest_point);
     tcase_add_test(tc, distance_gradient_matches_finite_differences);
     tcase_add_test(tc, minrad_gradient_matches_finite_differences);
     tcase_add_test(tc, minrad_exact_values);

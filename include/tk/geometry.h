@@ -44,7 +44,12 @@ typedef struct tk_closest {
 
 /* Parameters closer than this to 0 or 1 are snapped to the end point, so
  * that the two edges sharing a vertex see a contact at that vertex
- * identically (same closest points, same distance, bit for bit). */
+ * identically (same closest points, same distance, bit for bit); on an
+ * edge longer than the distance, closer than this times the distance
+ * over the edge's length, so that a snap never moves a closest point by
+ * more than 1e-7 of the distance (on an edge 6e7 long, 1e-7 of its
+ * parameter is 6 units: a pair 0.002 apart measured 1.002, and the flow
+ * passed one strand through the other). */
 #define TK_SNAP_PARAMETER 1e-7
 
 /* Closest points of two segments.  Where the minimum is not unique
