@@ -142,7 +142,7 @@ json_t *tk_json_basins(const tk_escape *e, size_t count, double final)
         while (j < n && seen[j] - seen[k] <= TK_BASIN_SAME * seen[k])
             j++;
         json_array_append_new(basins, json_pack("{s:o, s:I}", "ropelength",
-                                                tk_json_number(seen[k]), "reached",
+                                                tk_json_number(seen[k]), "times",
                                                 (json_int_t)(j - k)));
         if (k == 0)
             best = j - k;

@@ -54,7 +54,7 @@ json_t *tk_json_escapes(const tk_escape *e, size_t count);
  * explored tries, judged on the coarsest polygon only, and tries given up
  * are none.  Sightings within TK_BASIN_SAME (relative) of each other are
  * one basin.  `final` is the run's result (a sighting too when no try was
- * made).  {"basins": [{"ropelength", "reached"}] lowest first,
+ * made).  {"basins": [{"ropelength", "times"}] lowest first,
  * "best_reached": how many sightings the lowest basin had, "note": null,
  * or "found once: run longer or with more seeds" when that is 1}. */
 #define TK_BASIN_SAME 1e-4

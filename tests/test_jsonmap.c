@@ -246,9 +246,9 @@ START_TEST(basins_count_the_sightings)
     json_t *list = json_object_get(b, "basins");
     ck_assert_uint_eq(json_array_size(list), 2);
     ck_assert(json_real_value(json_object_get(json_array_get(list, 0), "ropelength")) == 71.001);
-    ck_assert_int_eq(json_integer_value(json_object_get(json_array_get(list, 0), "reached")), 2);
+    ck_assert_int_eq(json_integer_value(json_object_get(json_array_get(list, 0), "times")), 2);
     ck_assert(json_real_value(json_object_get(json_array_get(list, 1), "ropelength")) == 71.128);
-    ck_assert_int_eq(json_integer_value(json_object_get(json_array_get(list, 1), "reached")), 2);
+    ck_assert_int_eq(json_integer_value(json_object_get(json_array_get(list, 1), "times")), 2);
     ck_assert_int_eq(json_integer_value(json_object_get(b, "best_reached")), 2);
     ck_assert(json_is_null(json_object_get(b, "note")));
     json_decref(b);

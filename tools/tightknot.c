@@ -243,7 +243,7 @@ static const char tighten_help_end[] =
     "                          explored}], one per escape tried (explored: on\n"
     "                          the coarsest polygon alone, before the first\n"
     "                          refinement), basins: {basins: [{ropelength,\n"
-    "                          reached}], best_reached, note}, the distinct\n"
+    "                          times}], best_reached, note}, the distinct\n"
     "                          results its tightenings on the final polygon\n"
     "                          reached, lowest first, with how often (a\n"
     "                          lowest reached once is noted: run longer or\n"
@@ -893,7 +893,7 @@ static void print_basins(json_t *b)
     printf("  basins reached on the final polygon:");
     json_array_foreach(list, k, one)
         printf("%s %.9g (%lld)", k ? "," : "", json_real_value(json_object_get(one, "ropelength")),
-               (long long)json_integer_value(json_object_get(one, "reached")));
+               (long long)json_integer_value(json_object_get(one, "times")));
     const char *note = json_string_value(json_object_get(b, "note"));
     printf("%s%s\n", note ? "; the lowest " : "", note ? note : "");
     json_decref(b);

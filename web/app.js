@@ -79,7 +79,7 @@ function showBasins(b) {
     const dd = $('fig-basins');
     const list = b?.basins ?? [];
     dd.textContent = list.length
-        ? list.map((x) => `${Number(x.ropelength).toFixed(4)} ×${x.reached}`).join(', ') : '–';
+        ? list.map((x) => `${Number(x.ropelength).toFixed(4)} ×${x.times}`).join(', ') : '–';
     dd.classList.toggle('once', b?.note != null);
     dd.title = b?.note ? `the lowest ${b.note}`
         : list.length ? `the lowest reached ${b.best_reached} times` : 'not known before the run has stored its figures';

@@ -132,7 +132,7 @@ test('a catalogue knot submitted through the form is tightened and shown', async
     assert.equal(await page.locator('#fig-type').innerText(), '1 - t + t^2 (det 3)');
     // the basins the run reached, as the job says, lowest first
     assert.equal(await page.locator('#fig-basins').innerText(),
-        job.basins.basins.map((b) => `${b.ropelength.toFixed(4)} ×${b.reached}`).join(', '));
+        job.basins.basins.map((b) => `${b.ropelength.toFixed(4)} ×${b.times}`).join(', '));
     const d = await page.locator('#chart path.curve').getAttribute('d');
     assert.ok((d.match(/L/g) || []).length >= 2, 'the chart draws the history');
 
