@@ -64,16 +64,18 @@ run_unit() {
 # a core: each lane takes the next not yet taken (mkdir is the lock), so
 # a list ordered longest first has its lanes end together.  Each one's
 # output goes to a file of its own; they are printed in the list's order
-# at the end and their counts added to the totals.
+# at the end and their counts added to the totals.  $3 names the lanes'
+# directory when one function runs twice.
 in_lanes() {
-    mkdir "$lanes/$2"
+    lanedir=$lanes/${3:-$2}
+    mkdir "$lanedir"
     for _ in 1 2; do
         (
             i=0
             for t in $1; do
                 i=$((i + 1))
-                mkdir "$lanes/$2/taken.$i" 2>/dev/null || continue
-                $2 "$t" "$lanes/$2/log.$i" >"$lanes/$2/out.$i"
+                mkdir "$lanedir/taken.$i" 2>/dev/null || continue
+                $2 "$t" "$lanedir/log.$i" >"$lanedir/out.$i"
             done
         ) &
     done
@@ -81,7 +83,7 @@ in_lanes() {
     i=0
     for t in $1; do
         i=$((i + 1))
-        out="$lanes/$2/out.$i"
+        out="$lanedir/out.$i"
         counts=$(grep '^counts: ' "$out" 2>/dev/null | tail -n 1)
         if [ -z "$counts" ]; then
             failed=$((failed + 1)); echo "FAIL $t: no totals"; continue
@@ -186,10 +188,14 @@ if [ "$unit_only" -eq 0 ]; then
     # PostgreSQL: the files whose jobs are stored, restarted and shared
     # (the others poke the SQLite file or never store a job)
     [ -n "$TK_PG_URL" ] && suites="$suites pg:tests/service/run.sh"
+    # the fuzz targets' short runs last and alone: the service's workers
+    # yield the CPU to anything else (--worker-priority idle), so a fuzzer
+    # beside its suite would starve the jobs it waits for
     for t in tests/cli-*.sh tests/*/run.sh; do
-        case " $suites " in *" $t "*) ;; *) suites="$suites $t" ;; esac
+        case " $suites " in *" $t "*) ;; *) [ "$t" = tests/fuzz/run.sh ] || suites="$suites $t" ;; esac
     done
     in_lanes "$suites" run_suite
+    [ -f tests/fuzz/run.sh ] && in_lanes "tests/fuzz/run.sh" run_suite fuzz
 fi
 
 echo "tests: $passed passed, $failed failed, $skipped skipped"
