@@ -168,6 +168,28 @@ START_TEST(long_edge_keeps_its_closest_point)
 }
 END_TEST
 
+/* Two edges about 8e6 long, 7e6 from the origin, nearly antiparallel
+ * (a fuzzed 4-gon autoscaled to thickness 1): solved in the coordinates
+ * their closest points were off by 0.006 of a distance of 0.99, and the
+ * flow took a step to thickness 0.9977 believing it 1.0037 (in
+ * tests/fuzz/corpus/flow).  The exact distance, from rational arithmetic
+ * on these doubles, is 0.99127762490016... */
+START_TEST(long_nearly_parallel_edges_far_out)
+{
+    double v0[3] = {7469035.3920376794, -1.0499231529779648e-09, 4386.1325066092895};
+    double v1[3] = {7859949.4515956417, -5.2182183685806819e-09, 5482.6656329957195};
+    double v2[3] = {8772.2650178385611, -548.2665635470978, -548.26656328644629};
+    double v3[3] = {-1644.799600351035, -548.26656307676842, -548.26656327631451};
+    tk_closest c;
+    tk_segment_closest(v1, v2, v3, v0, &c);
+    ck_assert_double_eq_tol(c.dist, 0.9912776249001626, 1e-9);
+    ck_assert_double_eq_tol(c.s, 0.991898195306496, 1e-9);
+    ck_assert_double_eq_tol(c.t, 0.009908839195989845, 1e-9);
+    tk_segment_closest(v3, v0, v1, v2, &c);
+    ck_assert_double_eq_tol(c.dist, 0.9912776249001626, 1e-9);
+}
+END_TEST
+
 START_TEST(distance_gradient_matches_finite_differences)
 {
     tkt_rng r = {7};
@@ -359,6 +381,7 @@ int main(void)
     tcase_add_test(tc, segment_distance_matches_sampling);
     tcase_add_test(tc, segment_distance_exact_cases);
     tcase_add_test(tc, long_edge_keeps_its_closest_point);
+    tcase_add_test(tc, long_nearly_parallel_edges_far_out);
     tcase_add_test(tc, distance_gradient_matches_finite_differences);
     tcase_add_test(tc, minrad_gradient_matches_finite_differences);
     tcase_add_test(tc, minrad_exact_values);
