@@ -455,6 +455,7 @@ START_TEST(deform_keeps_type_and_thickness)
     ck_assert_double_eq_tol(other->xyz[3 * i] - c->xyz[3 * i], 0.5 * cos(phase), 1e-12);
     ck_assert(other->xyz[3 * i + 1] == c->xyz[3 * i + 1]);
     tk_error err;
+    tk_curve_free(&again);
     ck_assert_int_eq(tk_generate_deform(c, 7, 0.0, &again, &err), TK_EINVAL);
     ck_assert_ptr_null(again);
     tk_invariants_free(&was);
