@@ -627,7 +627,10 @@ static int read_whole(const char *path, char **data, size_t *size, tk_error *err
     size_t n = 0, cap = 0;
     *data = NULL;
     *size = 0;
-    FILE *f = fopen(path, "rb");
+    /* "-" is standard input as it is: opening /dev/stdin fails where it is
+     * a socket (a pipe from node's child_process is one) */
+    bool std_in = strcmp(path, "-") == 0;
+    FILE *f = std_in ? stdin : fopen(path, "rb");
     if (!f) {
         rc = tk_error_set(err, TK_EIO, "%s: cannot open: %s", path, strerror(errno));
         goto done;
@@ -689,7 +692,7 @@ static int read_whole(const char *path, char **data, size_t *size, tk_error *err
 
 done:
     free(buf);
-    if (f)
+    if (f && !std_in)
         fclose(f);
     return rc;
 }

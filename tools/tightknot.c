@@ -392,7 +392,7 @@ static void print_run_options(FILE *out)
 /* The path the engine reads for a command-line file name. */
 static const char *input_path(const char *name)
 {
-    return strcmp(name, "-") == 0 ? "/dev/stdin" : name;
+    return name; /* "-": tk_vect_read_file reads standard input */
 }
 
 /* Whether two paths name one file: the same file when both exist (links

@@ -33,7 +33,8 @@ typedef struct tk_vect_limits {
 int tk_vect_parse(const char *text, size_t len, const tk_vect_limits *limits,
                   tk_curve **out, tk_error *err);
 
-/* Reads and parses a file (message prefixed with the path). */
+/* Reads and parses a file (message prefixed with the path); "-" reads
+ * standard input. */
 int tk_vect_read_file(const char *path, const tk_vect_limits *limits,
                       tk_curve **out, tk_error *err);
 

@@ -8,7 +8,7 @@
 // name, a signed limit, a null option, a seed beyond 2^53.
 
 import assert from 'node:assert/strict';
-import { execFile } from 'node:child_process';
+import { execFile, spawnSync } from 'node:child_process';
 import { writeFileSync } from 'node:fs';
 import { createServer as createHttpServer } from 'node:http';
 import { connect, createServer } from 'node:net';
@@ -279,4 +279,15 @@ describe('the client prints what a server sends without its control characters',
         assert.doesNotMatch(out, /[\u0000-\u0008\u000b-\u001f\u007f\u0080-\u009f]/);
         assert.equal(out.trim().split('\n').length, 1, out);
     });
+});
+
+test("the command line reads '-' from standard input that is a socket (node's pipes are)", () => {
+    const knot = spawnSync(CLI, ['generate', 'torus', '2', '3'], { encoding: 'utf8' });
+    assert.equal(knot.status, 0);
+    const r = spawnSync(CLI, ['info', '--json', '-'], { input: knot.stdout, encoding: 'utf8' });
+    assert.equal(r.status, 0, r.stderr);
+    assert.deepEqual(JSON.parse(r.stdout).invariants.determinants, [3]);
+    const bad = spawnSync(CLI, ['info', '-'], { input: 'VECT\n1 2\n', encoding: 'utf8' });
+    assert.equal(bad.status, 2);
+    assert.match(bad.stderr, /^tightknot: -:2: /);
 });
