@@ -93,7 +93,11 @@ for (const p of [CLI, DAEMON])
     if (!existsSync(p)) usage(`${p} is missing: build it with make`);
 const out = resolve(opt.out);
 const startsDir = join(out, 'starts');
-const resultsDir = join(out, 'results');
+// one results directory per slice (the client's summary holds the files
+// of its own run only); the table reads them all
+const resultsRoot = join(out, 'results');
+const resultsDir = join(resultsRoot, opt.only ? `only-${opt.only.join('_')}`
+    : `slice-${slice[1]}-of-${slice[2]}`);
 mkdirSync(startsDir, { recursive: true });
 mkdirSync(resultsDir, { recursive: true });
 
@@ -204,22 +208,27 @@ async function submitAll(server, files) {
 // ---- the table
 
 function readSummary() {
-    const path = join(resultsDir, 'summary.tsv');
     const rows = new Map();
-    if (!existsSync(path)) return rows;
+    for (const dir of readdirSync(resultsRoot)) {
+        const path = join(resultsRoot, dir, 'summary.tsv');
+        if (existsSync(path)) readRows(path, join(resultsRoot, dir), rows);
+    }
+    return rows;
+}
+
+function readRows(path, dir, rows) {
     for (const line of readFileSync(path, 'utf8').split('\n')) {
         const f = line.split('\t');
         if (f.length < 10 || f[0] === 'name') continue;
         const [name, components, vertices, ropelength, thickness, residual, struts, steps, seconds, state] = f;
         rows.set(name, { name, components: +components, vertices: +vertices, ropelength: +ropelength,
-            struts: +struts, steps: +steps, seconds: +seconds, state });
+            struts: +struts, steps: +steps, seconds: +seconds, state, dir });
     }
-    return rows;
 }
 
-function kinksOf(start) {
+function kinksOf(start, dir) {
     try {
-        const doc = JSON.parse(readFileSync(join(resultsDir, `${start}.struts.json`), 'utf8'));
+        const doc = JSON.parse(readFileSync(join(dir, `${start}.struts.json`), 'utf8'));
         return doc.kinks?.length ?? '';
     } catch {
         return '';
@@ -258,7 +267,7 @@ function writeTable() {
         lines.push([knot, best.components, type, best.vertices,
             ok.map((s) => `${s.tag}=${s.ropelength.toFixed(6)}`).join(' '), best.ropelength.toFixed(6),
             best.tag, spread.toFixed(4), Number.isFinite(catAbove) ? catAbove.toFixed(4) : '',
-            best.struts, kinksOf(`${knot}@${best.tag}`),
+            best.struts, kinksOf(`${knot}@${best.tag}`, best.dir),
             ok.reduce((t, s) => t + s.seconds, 0).toFixed(0), failed.length, settings].join('\t'));
         summary.knots++;
         if (ok.length > 1) summary.compared++;
