@@ -11,34 +11,8 @@ import { connect } from 'node:net';
 import { join } from 'node:path';
 import { after, before, describe, test } from 'node:test';
 
-import { sleep, startDaemon, submit, tempDir, waitFinal } from './lib.mjs';
+import { raw, sleep, startDaemon, submit, tempDir, waitFinal } from './lib.mjs';
 
-// Sends `head` (a request line and headers, CRLF included) as raw bytes, so
-// that paths reach the daemon exactly as written; resolves to the status,
-// the headers as one string, and the body.
-function raw(port, head) {
-    return new Promise((resolve, reject) => {
-        const s = connect(port, '127.0.0.1');
-        let data = '';
-        s.setEncoding('latin1');
-        s.setTimeout(10000, () => {
-            s.destroy();
-            reject(new Error(`no answer in 10 s to ${JSON.stringify(head.slice(0, 80))}`));
-        });
-        s.on('data', (d) => (data += d));
-        s.on('error', reject);
-        s.on('end', () => {
-            const m = /^HTTP\/1\.[01] (\d{3})/.exec(data);
-            const split = data.indexOf('\r\n\r\n');
-            resolve({
-                status: m ? Number(m[1]) : 0,
-                headers: split >= 0 ? data.slice(0, split) : data,
-                body: split >= 0 ? data.slice(split + 4) : '',
-            });
-        });
-        s.write(head);
-    });
-}
 
 describe('the page\'s files stay inside the web root', () => {
     let d;

@@ -15,27 +15,8 @@ import { connect, createServer } from 'node:net';
 import { join } from 'node:path';
 import { after, before, describe, test } from 'node:test';
 
-import { CLI, DAEMON, CATALOGUE, PG_URL, pgDatabase, sleep, startDaemon, submit, tempDir, waitFinal } from './lib.mjs';
+import { CLI, DAEMON, CATALOGUE, PG_URL, pgDatabase, raw, sleep, startDaemon, submit, tempDir, waitFinal } from './lib.mjs';
 
-// Sends `head` as raw bytes; resolves to the status and the whole answer.
-function raw(port, head) {
-    return new Promise((resolve, reject) => {
-        const s = connect(port, '127.0.0.1');
-        let data = '';
-        s.setEncoding('latin1');
-        s.setTimeout(10000, () => {
-            s.destroy();
-            reject(new Error(`no answer in 10 s to ${JSON.stringify(head.slice(0, 80))}`));
-        });
-        s.on('data', (d) => (data += d));
-        s.on('error', reject);
-        s.on('end', () => {
-            const m = /^HTTP\/1\.[01] (\d{3})/.exec(data);
-            resolve({ status: m ? Number(m[1]) : 0, text: data });
-        });
-        s.write(head);
-    });
-}
 
 // A daemon run to its end (one that must not start): its exit status and output.
 function runDaemon(args) {

@@ -13,6 +13,7 @@
 // Relative paths in the environment are taken from the current directory,
 // the defaults from the repository root.
 
+import { connect } from 'node:net';
 import assert from 'node:assert/strict';
 import { spawn, execFile, execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
@@ -192,6 +193,34 @@ export async function request(base, method, path, opts = {}) {
 
 // Numbers as the daemon wrote them: JSON.parse keeps every double exactly
 // (both sides print 17 significant digits), so === compares bits.
+
+// Sends `head` (a request line and headers, CRLF included) as raw bytes, so
+// that paths reach the daemon exactly as written; resolves to the status,
+// the headers as one string, the body, and the whole answer (text).
+export function raw(port, head) {
+    return new Promise((resolve, reject) => {
+        const s = connect(port, '127.0.0.1');
+        let data = '';
+        s.setEncoding('latin1');
+        s.setTimeout(10000, () => {
+            s.destroy();
+            reject(new Error(`no answer in 10 s to ${JSON.stringify(head.slice(0, 80))}`));
+        });
+        s.on('data', (d) => (data += d));
+        s.on('error', reject);
+        s.on('end', () => {
+            const m = /^HTTP\/1\.[01] (\d{3})/.exec(data);
+            const split = data.indexOf('\r\n\r\n');
+            resolve({
+                status: m ? Number(m[1]) : 0,
+                headers: split >= 0 ? data.slice(0, split) : data,
+                body: split >= 0 ? data.slice(split + 4) : '',
+                text: data,
+            });
+        });
+        s.write(head);
+    });
+}
 
 // ---------------------------------------------------------------- the daemon
 
