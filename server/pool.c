@@ -12,10 +12,9 @@
 
 /* ---- the workers ---- */
 
-/* Workers yield to the threads answering requests: with SCHED_IDLE a
- * waking request preempts a worker at once (polling p99 4-5 ms against
- * 5-8 ms with niceness alone, bench/service.sh).  Linux, per thread; a
- * failure only costs latency. */
+/* Workers yield to the threads answering requests: SCHED_IDLE lets a
+ * request preempt a worker at once (polling p99 4-5 ms against 5-8 ms
+ * with niceness alone, bench/service.sh); a failure only costs latency. */
 static void set_priority(tk_priority priority)
 {
     pthread_setname_np(pthread_self(), "tk-worker");
@@ -23,6 +22,25 @@ static void set_priority(tk_priority priority)
         pthread_setschedparam(pthread_self(), SCHED_IDLE, &(struct sched_param){0});
     if (priority != TK_PRIORITY_NORMAL)
         setpriority(PRIO_PROCESS, (id_t)syscall(SYS_gettid), 5);
+}
+
+/* Waits on cv at most a second.  Lock held. */
+static void wait_second(tk_pool *p, pthread_cond_t *cv)
+{
+    struct timespec until;
+    clock_gettime(CLOCK_REALTIME, &until);
+    until.tv_sec += 1;
+    pthread_cond_timedwait(cv, &p->lock, &until);
+}
+
+void tk_slot_stop(slot *sl, bool cancel)
+{
+    if (cancel)
+        sl->cancel = true;
+    else
+        sl->lost = true;
+    if (sl->run)
+        tk_run_cancel(sl->run);
 }
 
 static void *worker(void *arg)
@@ -48,21 +66,16 @@ static void *worker(void *arg)
         if (claimed)
             tk_worker_run(sl, id);
         pthread_mutex_lock(&p->lock);
-        if (!claimed && !p->stopping && p->submitted == seen) {
-            struct timespec until;
-            clock_gettime(CLOCK_REALTIME, &until);
-            until.tv_sec += 1;
-            pthread_cond_timedwait(&p->wake, &p->lock, &until);
-        }
+        if (!claimed && !p->stopping && p->submitted == seen)
+            wait_second(p, &p->wake);
     }
     pthread_mutex_unlock(&p->lock);
     return NULL;
 }
 
 /* Renews the claims of the jobs running here every second (a lease is
- * several seconds), and passes on what the store says: a cancellation
- * asked through another daemon, or a job lost to one (its lease ran out
- * while this daemon could not reach the store). */
+ * several), and passes on a cancellation asked through another daemon or
+ * a job lost to one (its lease ran out while the store was out of reach). */
 static void *keeper(void *arg)
 {
     tk_pool *p = arg;
@@ -80,23 +93,13 @@ static void *keeper(void *arg)
             if (rc != TK_ENOTFOUND && !cancel)
                 continue; /* held (or the store out of reach: the next round tries again) */
             pthread_mutex_lock(&p->lock);
-            slot *sl = &p->slots[i];
-            if (sl->id == ids[i]) { /* still the same job */
-                if (cancel)
-                    sl->cancel = true;
-                else
-                    sl->lost = true;
-                if (sl->run)
-                    tk_run_cancel(sl->run);
-            }
+            if (p->slots[i].id == ids[i]) /* still the same job */
+                tk_slot_stop(&p->slots[i], cancel);
             pthread_mutex_unlock(&p->lock);
         }
-        struct timespec until;
-        clock_gettime(CLOCK_REALTIME, &until);
-        until.tv_sec += 1;
         pthread_mutex_lock(&p->lock);
         if (!p->stopping)
-            pthread_cond_timedwait(&p->tick, &p->lock, &until);
+            wait_second(p, &p->tick);
     }
     pthread_mutex_unlock(&p->lock);
     free(ids);
@@ -220,9 +223,8 @@ int tk_pool_cancel(tk_pool *p, int64_t id, json_t **doc, tk_error *err)
 {
     *doc = NULL;
     int rc = TK_EINVAL;
-    /* queued: cancelled now; running: marked, here or on another daemon
-     * (which learns it at its next renewal); between the two (claimed or
-     * queued again a moment ago), ask again */
+    /* queued: cancelled now; running: marked (another daemon learns it at
+     * its next renewal); between the two a moment ago: ask again */
     for (int tries = 0; tries < 3 && rc == TK_EINVAL; tries++) {
         rc = tk_store_cancel(p->store, id, err);
         if (rc == TK_OK)
@@ -244,9 +246,7 @@ int tk_pool_cancel(tk_pool *p, int64_t id, json_t **doc, tk_error *err)
     pthread_mutex_lock(&p->lock);
     slot *sl = running(p, id);
     if (sl) { /* running here: it stops within a step */
-        sl->cancel = true;
-        if (sl->run)
-            tk_run_cancel(sl->run);
+        tk_slot_stop(sl, true);
         *doc = tk_slot_doc(sl);
     }
     pthread_mutex_unlock(&p->lock);

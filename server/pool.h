@@ -2,41 +2,33 @@
  *
  * The contract:
  * - Ordering.  The store is the queue: a free worker claims the queued
- *   job of the earliest turn (tk_store_claim).  Owners (token names) take
- *   turns, round robin: a job's turn is one past its owner's latest job
- *   waiting or running, or past the newest running job's when it has
- *   none; so one owner's many queued jobs delay another's next job by
- *   one or two of theirs, not all, and an owner's own jobs start in the
- *   order they came.  tk_pool_submit stores a job and wakes a worker;
- *   workers that find nothing look again every second.
+ *   job of the earliest turn (tk_store_claim): owners take turns, round
+ *   robin, and an owner's own jobs start in the order they came.
+ *   tk_pool_submit stores a job and wakes a worker; idle workers look
+ *   again every second.
  * - Running.  A worker runs the engine with the job's options exactly as
- *   `tightknot tighten` would (its whole schedule), keeps the job's
- *   document current at every step (tk_pool_live reads it) and writes it,
- *   with its curve, contacts, history, resume point and new frames, every
- *   flush_seconds and at the end, in one transaction.  Frames are stored
- *   only while the owner's stored bytes stay within owner_bytes; the
- *   others are refused and counted (frames_refused).  A start the engine
- *   refuses ends the job `failed` with the engine's message.
+ *   `tightknot tighten` would, keeps the job's document current at every
+ *   step (tk_pool_live) and writes it with its curve, contacts, history,
+ *   resume point and new frames every flush_seconds and at the end, in
+ *   one transaction.  Frames beyond the owner's owner_bytes are refused
+ *   and counted (frames_refused).  A start the engine refuses fails the job.
  * - Cancellation.  A queued job is cancelled in the store at once; a
  *   running one stops within a step and is stored `cancelled`: at once
- *   when it runs here, else when its daemon next renews its claim.
+ *   here, else when its daemon next renews its claim.
  * - Claims.  A thread renews the claims of the jobs running here every
- *   second (tk_store_renew): it learns of cancellations asked through
- *   other daemons, and of jobs lost to them (a lease that ran out), which
- *   stop without another write.
+ *   second: it learns of cancellations asked through other daemons, and
+ *   of jobs lost to them (a lease ran out), which stop without a write.
  * - Shutdown.  tk_pool_halt stops the running jobs within a step, stores
  *   them `queued` with their resume point, and joins the workers; the pool
  *   stays readable until tk_pool_free.
- * - Resume.  tk_pool_start queues again what the store holds as running
- *   (a stop or a crash; a shared store leaves that to the leases); such a
- *   job goes on from its stored resume point (tk_run_resume), numbering
- *   its steps on.
- * - Store failures.  When a write fails (a full disk) the job pauses: its
- *   document's error says why and the write is retried every second until
- *   it succeeds or the pool halts (the job then resumes at the next start).
- *   The pause is counted in paused_seconds and not spent of the time
- *   budget: the run goes on in a new one resumed from it, as after a
- *   restart, its clock where the pause began.
+ * - Resume.  tk_pool_start queues again what SQLite holds as running (a
+ *   stop or a crash; PostgreSQL leaves it to the leases); such a job goes
+ *   on from its stored resume point, numbering its steps on.
+ * - Store failures.  When a write fails (a full disk) the job pauses, its
+ *   document's error saying why, and the write is retried every second
+ *   until it succeeds or the pool halts.  The pause is counted in
+ *   paused_seconds, not spent of the time budget: the run goes on in a
+ *   new one resumed from it, its clock where the pause began.
  * - Locks.  One mutex guards the workers' slots; no store call and no
  *   engine step is made while it is held, so a request never waits for a
  *   worker longer than a copy of a document.
@@ -63,15 +55,15 @@ typedef struct tk_pool_config {
     FILE *log;            /* a line per job taken up and let go (NULL: none) */
 } tk_pool_config;
 
-/* What a job may keep of its frames: at most this many and this many
- * bytes (a frame of V vertices is 24 V bytes). */
+/* What a job may keep of its frames: this many, this many bytes (a
+ * frame of V vertices is 24 V). */
 #define TK_MAX_FRAMES 1000
 #define TK_MAX_FRAME_BYTES (256u << 20)
 
 typedef struct tk_pool tk_pool;
 
-/* Starts the workers, which take up jobs once tk_pool_go is called (so the
- * daemon can say where it listens before the log's first job line). */
+/* Starts the workers; they take up jobs after tk_pool_go (so the daemon
+ * says where it listens before the log's first job line). */
 int tk_pool_start(tk_store *store, const tk_pool_config *cfg, tk_pool **out, tk_error *err);
 void tk_pool_go(tk_pool *p);
 void tk_pool_halt(tk_pool *p);
@@ -84,9 +76,8 @@ int tk_pool_submit(tk_pool *p, json_t *doc, const char *input, tk_error *err);
 /* A job running here: a copy of its document now; NULL otherwise. */
 json_t *tk_pool_live(tk_pool *p, int64_t id);
 
-/* Cancels a queued or running job, *doc its document after (state
- * `cancelled`, or `running` until it stops).  TK_EINVAL when the job has
- * ended, TK_ENOTFOUND when there is none. */
+/* Cancels a queued or running job, *doc its document after (`running`
+ * until it stops).  TK_EINVAL when it has ended, TK_ENOTFOUND: none. */
 int tk_pool_cancel(tk_pool *p, int64_t id, json_t **doc, tk_error *err);
 
 typedef struct tk_pool_stats {

@@ -1,12 +1,8 @@
-/* tightknot service: the job store (see store.h), on SQLite or on
- * PostgreSQL (store_db.h).  Every operation is written once, as SQL run
- * through one primitive (query) that either backend answers; a statement
- * has a text of each backend's only where their dialects differ (the
- * claim, the renewal, the requeue at start and the locking).
- *
- * Each call takes a connection of its own (kept for reuse), so requests
- * and workers never wait for each other here: SQLite's WAL lets readers
- * go on beside the one writer, PostgreSQL's row locks do the rest. */
+/* tightknot service: the job store (see store.h).  Every operation is
+ * written once, as SQL either backend runs (store_db.h); only the claim,
+ * the renewal, the requeue and the locking have a text per dialect.  Each
+ * call takes a connection of its own (kept for reuse), so requests and
+ * workers never wait for each other here. */
 #include "store.h"
 
 #include <pthread.h>
@@ -18,16 +14,12 @@
 #include "jsonmap.h"
 #include "store_db.h"
 
-
 #define MATCHING                                                                                \
     " FROM jobs WHERE ($1 IS NULL OR state = $1) AND ($2 IS NULL OR owner = $2)"
 
 #define PART_NAME(E, col, n, sql) #col,
 static const char *const part_columns[TK_PARTS] = {TK_PART_COLUMNS(PART_NAME)};
 _Static_assert(TK_PARTS == 5, "tk_store_put passes the parts as $3..$7: name them there");
-
-
-/* ---- the operations ---- */
 
 /* The document as stored: its id and state are the columns'. */
 static char *doc_text(const json_t *doc)
@@ -69,8 +61,7 @@ int tk_store_add(tk_store *s, json_t *doc, const char *input, const tk_store_lim
         return store_written(s, TK_EIO, err);
     char *text = doc_text(doc);
     const char *owner = json_string_value(json_object_get(doc, "owner"));
-    /* under one lock across daemons, the insert's counts see every
-     * submission before it */
+    /* under one lock across daemons: the counts see every submission before */
     rows r = {0};
     bool ok = text && db_script(s->db, c, s->db->begin) && db_script(s->db, c, s->db->lock) &&
               db_query(s->db, c, &r, s->db->add, "jxitii", text, input, (int64_t)limits->queued,
@@ -86,14 +77,8 @@ int tk_store_add(tk_store *s, json_t *doc, const char *input, const tk_store_lim
 }
 
 int tk_store_put(tk_store *s, const json_t *doc, const char *const *parts,
-                 const tk_frame *frames, size_t first, size_t nframes, tk_error *err)
-{
-    return tk_store_put_within(s, doc, parts, frames, first, nframes, 0, NULL, err);
-}
-
-int tk_store_put_within(tk_store *s, const json_t *doc, const char *const *parts,
-                        const tk_frame *frames, size_t first, size_t nframes, size_t owner_bytes,
-                        size_t *fit, tk_error *err)
+                 const tk_frame *frames, size_t first, size_t nframes, size_t owner_bytes,
+                 size_t *fit, tk_error *err)
 {
     void *c = store_take(s, err);
     if (!c)
@@ -104,9 +89,8 @@ int tk_store_put_within(tk_store *s, const json_t *doc, const char *const *parts
     const char *owner = json_string_value(json_object_get(doc, "owner"));
     bool limited = owner && owner_bytes && nframes;
     rows r = {0};
-    /* a limited write holds the submissions' lock (PostgreSQL; SQLite's
-     * writers take turns anyway): its count of the owner's bytes stays
-     * true until it commits */
+    /* a limited write holds the submissions' lock: its count of the
+     * owner's bytes stays true until it commits */
     bool ok = text && db_script(s->db, c, s->db->begin) &&
               (!limited || db_script(s->db, c, s->db->lock)) &&
               db_query(s->db, c, &r, s->db->put, "tjxxxxxitd", tk_job_states[tk_job_state_in(doc)],
@@ -118,9 +102,8 @@ int tk_store_put_within(tk_store *s, const json_t *doc, const char *const *parts
     ok = ok && !rc &&
          db_query(s->db, c, NULL, "DELETE FROM frames WHERE job = $1 AND seq >= $2", "ii", id,
                (int64_t)first);
-    /* the frames that fit beside all else the owner has stored, this
-     * document and these parts included; the write is undone when not
-     * all of them do, for the caller to write its count again */
+    /* the frames that fit beside all else the owner stored, this write's
+     * included; when not all do, it is undone for the caller to retry */
     size_t n = 0;
     if (ok && !rc && limited && (ok = db_query(s->db, c, &r, s->db->owner_bytes, "t", owner))) {
         int64_t room = (int64_t)owner_bytes - rows_int(&r, 0, 0), size;
@@ -145,9 +128,8 @@ int tk_store_put_within(tk_store *s, const json_t *doc, const char *const *parts
     return store_written(s, rc, err);
 }
 
-/* The document of row i of (doc, id, state): the id and state are the
- * columns'.  NULL (TK_EPARSE in err, and the store reported damaged) when
- * it does not read back: SQLite checks its pages, not a row's bytes. */
+/* The document of row i of (doc, id, state); NULL (TK_EPARSE, the store
+ * reported damaged) when it does not read back. */
 static json_t *row_doc(tk_store *s, const rows *r, size_t i, tk_error *err)
 {
     json_t *doc = rows_cell(r, i, 0) ? json_loads(rows_cell(r, i, 0), 0, NULL) : NULL;
@@ -163,8 +145,8 @@ static json_t *row_doc(tk_store *s, const rows *r, size_t i, tk_error *err)
     return NULL;
 }
 
-/* Runs a query (as query says) on a connection of its own; its rows in
- * *r (empty when it fails: TK_EIO, saying `what` failed). */
+/* Runs a query (db_query) on a connection of its own; its rows in *r
+ * (empty when it fails: TK_EIO, saying `what` failed). */
 static int ask(tk_store *s, rows *r, const char *what, tk_error *err, const char *sql,
                const char *types, ...)
 {
@@ -181,9 +163,8 @@ static int ask(tk_store *s, rows *r, const char *what, tk_error *err, const char
     return rc;
 }
 
-/* Job id's document as read at `at`, when no write came since
- * (`writes`), is kept to be served for RECENT_AGE; with doc NULL, a copy
- * of the one kept, if it is still fresh, or NULL. */
+/* Keeps doc, job id's as read at `at`, when no write came since `writes`;
+ * with doc NULL, a copy of the one kept while fresh (RECENT_AGE), or NULL. */
 static json_t *recent(tk_store *s, int64_t id, uint64_t writes, double at, const json_t *doc)
 {
     json_t *copy = NULL;
@@ -234,7 +215,7 @@ int tk_store_part(tk_store *s, int64_t id, tk_part part, char **text, size_t *le
     if (!rc && !r.n)
         rc = tk_error_set(err, TK_ENOTFOUND, "no such job");
     if (!rc && len)
-        *len = r.len[0];
+        *len = r.cell[0].len;
     if (!rc)
         *text = rows_steal(&r, 0, 0);
     rows_free(&r);
@@ -264,8 +245,8 @@ int tk_store_list(tk_store *s, int state, const char *owner, size_t offset, size
     return rc;
 }
 
-/* Runs an UPDATE or DELETE on one job (its id $1; $2, $3 two texts, or
- * NULL); TK_EINVAL with `why` when it changes nothing. */
+/* An UPDATE or DELETE of job $1 ($2, $3 texts or NULL); TK_EINVAL with
+ * `why` when it changes nothing. */
 static int change(tk_store *s, const char *sql, int64_t id, const char *two, const char *three,
                   const char *why, tk_error *err)
 {
@@ -277,8 +258,8 @@ static int change(tk_store *s, const char *sql, int64_t id, const char *two, con
     return store_written(s, rc, err);
 }
 
-/* The document read, its end set, and written back only while it is the
- * one read (a claim since: not queued, EINVAL, and the caller asks again). */
+/* Written back only while the document is the one read: a claim since
+ * makes it TK_EINVAL, and the caller asks again. */
 int tk_store_cancel(tk_store *s, int64_t id, tk_error *err)
 {
     rows r;
@@ -355,7 +336,7 @@ int tk_store_frames(tk_store *s, int64_t id, size_t offset, size_t limit, tk_fra
     for (size_t i = 0; !rc && i < r.n && *n < limit; i++) {
         tk_frame *f = &(*out)[(*n)++];
         f->step = (long)rows_int(&r, i, 0);
-        f->count = r.len[i * r.ncol + 1] / sizeof(double);
+        f->count = r.cell[i * r.ncol + 1].len / sizeof(double);
         f->xyz = (double *)(void *)rows_steal(&r, i, 1);
         f->layout = rows_steal(&r, i, 2);
     }
@@ -408,8 +389,7 @@ bool tk_store_health(tk_store *s, char *reason, size_t size)
     pthread_mutex_unlock(&s->lock);
     if (reason[0])
         return false;
-    /* a read that walks to the newest row: a damaged file shows here as
-     * "malformed" before a client's read finds it */
+    /* a read of the newest row: damage shows here before a client finds it */
     tk_error err;
     json_t *docs = NULL;
     size_t total = 0;

@@ -1,5 +1,5 @@
-/* tightknot service: what the store's two backends share (store_db.h):
- * rows, parameters, and the connections, opened once and kept for reuse. */
+/* tightknot service: what the store's backends share (store_db.h): rows,
+ * parameters, and the connections, kept for reuse. */
 #include "store_db.h"
 
 #include <assert.h>
@@ -15,37 +15,32 @@
 void rows_free(rows *r)
 {
     for (size_t k = 0; r->cell && k < r->n * r->ncol; k++)
-        free(r->cell[k]);
+        free(r->cell[k].p);
     free(r->cell);
-    free(r->len);
     *r = (rows){0};
 }
 
 bool rows_add(rows *r, size_t j, const void *p, size_t len)
 {
     if (j == 0) {
-        size_t m = (r->n + 1) * r->ncol;
-        char **cell = realloc(r->cell, m * sizeof *cell);
-        r->cell = cell ? cell : r->cell;
-        size_t *lens = cell ? realloc(r->len, m * sizeof *lens) : NULL;
-        if (!lens)
+        struct cell *grown = realloc(r->cell, (r->n + 1) * r->ncol * sizeof *grown);
+        if (!grown)
             return false;
-        r->len = lens;
-        memset(r->cell + r->n * r->ncol, 0, r->ncol * sizeof *r->cell);
-        r->n++;
+        r->cell = grown;
+        memset(r->cell + r->n++ * r->ncol, 0, r->ncol * sizeof *r->cell);
     }
-    size_t k = (r->n - 1) * r->ncol + j;
-    r->len[k] = len;
-    if (p && (r->cell[k] = malloc(len + 1)) != NULL) {
-        memcpy(r->cell[k], p, len);
-        r->cell[k][len] = '\0';
+    struct cell *k = &r->cell[(r->n - 1) * r->ncol + j];
+    k->len = len;
+    if (p && (k->p = malloc(len + 1)) != NULL) {
+        memcpy(k->p, p, len);
+        k->p[len] = '\0';
     }
-    return !p || r->cell[k];
+    return !p || k->p;
 }
 
 const char *rows_cell(const rows *r, size_t i, size_t j)
 {
-    return r->cell[i * r->ncol + j];
+    return r->cell[i * r->ncol + j].p;
 }
 
 int64_t rows_int(const rows *r, size_t i, size_t j)
@@ -55,8 +50,8 @@ int64_t rows_int(const rows *r, size_t i, size_t j)
 
 char *rows_steal(rows *r, size_t i, size_t j)
 {
-    char *p = r->cell[i * r->ncol + j];
-    r->cell[i * r->ncol + j] = NULL;
+    char *p = r->cell[i * r->ncol + j].p;
+    r->cell[i * r->ncol + j].p = NULL;
     return p;
 }
 
@@ -107,7 +102,6 @@ bool db_query(const backend *db, void *c, rows *out, const char *sql, const char
 
 /* ---- connections ---- */
 
-/* The connection's last error, on one line, as TK_EIO. */
 int store_failed(const tk_store *s, void *c, tk_error *err, const char *what)
 {
     const char *m = s->db->error(c);
@@ -115,7 +109,7 @@ int store_failed(const tk_store *s, void *c, tk_error *err, const char *what)
     return tk_error_set(err, TK_EIO, "job store: %s: %.*s", what, (int)n, n ? m : "no answer");
 }
 
-/* A connection for this call; the lock only guards the list. */
+/* The lock only guards the list. */
 void *store_take(tk_store *s, tk_error *err)
 {
     pthread_mutex_lock(&s->lock);
@@ -124,8 +118,6 @@ void *store_take(tk_store *s, tk_error *err)
     return c ? c : s->db->connect(s->where, s->label, false, err);
 }
 
-/* Back to the list, what did not commit rolled back, unless it broke (a
- * lost server). */
 void store_give(tk_store *s, void *c)
 {
     bool keep = s->db->release(c);
@@ -139,9 +131,6 @@ void store_give(tk_store *s, void *c)
         s->db->disconnect(c);
 }
 
-/* Notes a write's outcome for health: a failure to reach or write the
- * store (TK_EIO, TK_ENOMEM) until the next write that succeeds; answers
- * about the job (busy, not found, not queued) are neither.  Returns rc. */
 int store_written(tk_store *s, int rc, const tk_error *err)
 {
     pthread_mutex_lock(&s->lock);

@@ -1,7 +1,6 @@
 /* tightknot service: the store's two backends (store_sqlite.c,
- * store_pg.c) behind the table store.c speaks through.  A backend runs a
- * statement with its parameters and hands back its rows as text; the
- * operations, their SQL and the connections' reuse are store.c's. */
+ * store_pg.c) behind the table store.c speaks through: a backend runs a
+ * statement with its parameters and hands back its rows as text. */
 #ifndef TK_SERVER_STORE_DB_H
 #define TK_SERVER_STORE_DB_H
 
@@ -18,11 +17,13 @@
 #define MAX_PARAMS 10
 
 /* A result: n rows of ncol cells, each a NUL-terminated copy (NULL for a
- * SQL null), and the rows a change touched. */
+ * SQL null) with its length, and the rows a change touched. */
 typedef struct rows {
     size_t n, ncol, changed;
-    char **cell;
-    size_t *len;
+    struct cell {
+        char *p;
+        size_t len;
+    } *cell;
 } rows;
 
 void rows_free(rows *r);
@@ -47,8 +48,8 @@ typedef struct params {
 } params;
 
 typedef struct backend {
-    /* A connection (create: the SQLite file may be made), or NULL with
-     * TK_EIO naming `label`. */
+    /* A connection (create: the file may be made), or NULL with TK_EIO
+     * naming `label`. */
     void *(*connect)(const char *where, const char *label, bool create, tk_error *err);
     void (*disconnect)(void *c);
     const char *(*error)(void *c);
@@ -58,27 +59,22 @@ typedef struct backend {
     bool (*run)(void *c, rows *r, const char *sql, const params *p);
     /* Rolls back what did not commit; whether c may be used again. */
     bool (*release)(void *c);
-    /* Creates the tables, or brings a store of an earlier version up to
-     * date; whether it could. */
+    /* Creates the tables or brings an earlier version's up to date. */
     bool (*setup)(void *c);
     /* `where` as messages name it (never a password). */
     void (*label)(const char *where, char *out, size_t size);
     /* Why the file system cannot take a write, into reason (NULL: no file). */
     void (*room)(const char *where, char *reason, size_t size);
-    /* The dialect, where the two differ: the claim, the renewal, the
-     * requeue at start and the lock over submissions (NULL: none), and
-     * the statements built from store.c's shared text with the dialect's
-     * words. */
+    /* The statements where the dialects differ (NULL: none), and those
+     * built from the shared text below with the dialect's words. */
     const char *claim, *renew, *requeue, *begin, *lock, *add, *put, *owner_bytes;
 } backend;
 
-/* Statements without parameters whose results are not needed (NULL:
- * none for this backend); whether they ran. */
+/* Runs statements without parameters or results (NULL: none). */
 bool db_script(const backend *db, void *c, const char *sql);
-/* Runs a statement (NULL: none for this backend) whose parameters $1,
- * $2, ... are given by `types` (params; b takes a pointer and a size_t
- * length).  Its rows go to *out when not NULL.  Whether it ran (the
- * connection's error says why not). */
+/* Runs a statement (NULL: none) with parameters $1, $2, ... by `types`
+ * (params; b takes a pointer and a size_t length), its rows to *out
+ * unless NULL.  Whether it ran (the connection's error says why not). */
 bool db_query(const backend *db, void *c, rows *out, const char *sql, const char *types, ...);
 bool db_vquery(const backend *db, void *c, rows *out, const char *sql, const char *types,
                va_list ap);
@@ -88,10 +84,9 @@ const backend *tk_store_pg(void);
 
 #define IDLE_MAX 32 /* connections kept for reuse; more are opened while needed */
 /* On a shared store the documents last read are served again for a
- * moment: a daemon that runs nothing answers a crowd of pollers of a job
- * running elsewhere from memory, not with a query each (the job's own
- * daemon writes it only every 2 s anyway).  Any write through this store
- * drops them all, so a client sees its own DELETE at once. */
+ * moment: pollers of a job running elsewhere (written every 2 s anyway)
+ * cost no query each.  Any write through this store drops them all, so a
+ * client sees its own DELETE at once. */
 #define RECENT_MAX 64   /* documents kept, one slot per id modulo this */
 #define RECENT_AGE 0.5  /* seconds a kept document is served again */
 
@@ -122,22 +117,21 @@ int store_failed(const struct tk_store *s, void *c, tk_error *err, const char *w
  * commit rolled back, kept unless it broke (a lost server). */
 void *store_take(struct tk_store *s, tk_error *err);
 void store_give(struct tk_store *s, void *c);
-/* Notes a write's outcome for health: a failure to reach or write the
- * store (TK_EIO, TK_ENOMEM) until the next write that succeeds; answers
- * about the job (busy, not found, not queued) are neither.  Returns rc. */
+/* Notes a write's outcome for health: TK_EIO or TK_ENOMEM until a write
+ * succeeds (busy, not found, not queued are answers, not failures).
+ * Returns rc. */
 int store_written(struct tk_store *s, int rc, const tk_error *err);
 
 /* The advisory lock that makes a submission's limits and insert one step
  * across daemons (any number no other program on the database uses). */
 #define ADD_LOCK "7310519"
 
-/* The shared SQL's texts, with the dialect's words: B(column) a column's
- * size in bytes (DOC_BYTES the document's), LEASE what a write of a running job sets besides.  The bytes stored for owner P's jobs, frames
- * included; the limits and the insert in one statement ($1 doc, $2
- * input, $3 queue, $4 owner, $5 its jobs, $6 its bytes: two requests
- * cannot both take the last place).  A job's turn is one past the latest
- * of its owner's jobs waiting or running, or past the newest running
- * job's (store.h); no name is owner '' (the owner column's null). */
+/* The shared SQL, with the dialect's words: B(column) a column's bytes
+ * (DOC_BYTES the document's), LEASE what writing a running job sets
+ * besides.  SQL_OWNER_BYTES: owner P's stored bytes, frames included.
+ * SQL_ADD: the limits and the insert in one statement ($1 doc, $2 input,
+ * $3 queue, $4 owner, $5 its jobs, $6 its bytes), the turn as store.h
+ * says; owner '' is the column's null. */
 #define SQL_PART_BYTES(E, col, n, sql) " + " B(#col)
 #define SQL_OWNER_BYTES(P)                                                                      \
     "SELECT CAST(coalesce(sum(" DOC_BYTES TK_PART_COLUMNS(SQL_PART_BYTES) " + (SELECT"           \

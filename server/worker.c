@@ -20,10 +20,9 @@ typedef struct job_run {
     tk_run *run;
     json_t *before;          /* a resumed job's history before its resume */
     tk_frame *pending;       /* frames taken since the last write */
-    size_t npending, cap;
+    size_t npending;
     size_t stored;           /* frames in the store */
-    long frame_after;        /* frames are due after this step (a resumed
-                                run's frame of its first step is stored) */
+    long frame_after;        /* frames are due after this step */
     long last_step;          /* the last step reported, -1 before */
     double last_flush;
     bool rebase;             /* the store paused the run: it goes on in another (rebase) */
@@ -41,10 +40,9 @@ static void drop_frame(job_run *jr)
     free(jr->pending[jr->npending].layout);
 }
 
-/* Keeps the curve as a frame when its step is on the `every` grid.  The
- * worker takes frames itself rather than the engine's snapshots: they
- * keep the grid of the job's steps across a resume and have the vertices
- * of their step (coarse to fine resamples). */
+/* Keeps the curve as a frame when its step is on the `every` grid: the
+ * worker's frames, not the engine's snapshots, keep the job's grid across
+ * a resume and the vertices of their step (the run resamples). */
 static void take_frame(job_run *jr, long step, bool again)
 {
     long every = jr->opts.every;
@@ -62,15 +60,10 @@ static void take_frame(job_run *jr, long step, bool again)
     if (step <= jr->frame_after || jr->stored + jr->npending >= (most < TK_MAX_FRAMES ? most
                                                                                     : TK_MAX_FRAMES))
         return;
-    if (jr->npending == jr->cap) {
-        size_t cap = jr->cap ? 2 * jr->cap : 8;
-        tk_frame *grown = realloc(jr->pending, cap * sizeof *grown);
-        if (!grown)
-            return; /* out of memory: this frame is left out */
+    tk_frame *grown = realloc(jr->pending, (jr->npending + 1) * sizeof *grown);
+    if (grown) /* else out of memory: this frame is left out */
         jr->pending = grown;
-        jr->cap = cap;
-    }
-    tk_frame f = {step, malloc(per * sizeof(double)), per, tk_record_layout(c)};
+    tk_frame f = {step, grown ? malloc(per * sizeof(double)) : NULL, per, tk_record_layout(c)};
     if (f.xyz && f.layout) {
         memcpy(f.xyz, c->xyz, per * sizeof(double));
         jr->pending[jr->npending++] = f;
@@ -83,8 +76,6 @@ static void take_frame(job_run *jr, long step, bool again)
 
 /* ---- storing ---- */
 
-/* The slot's job as it stands: its document with the latest figures
- * (made here, not at every step).  Lock held. */
 json_t *tk_slot_doc(const slot *sl)
 {
     json_t *doc = json_deep_copy(sl->doc);
@@ -105,19 +96,8 @@ static json_t *invariants_json(const job_run *jr)
                      tk_json_invariants(jr->run ? tk_run_type_latest(jr->run) : &jr->refused));
 }
 
-/* The store no longer has the slot's job held here: its lease ran out
- * and another daemon took it up, so this run stops without writing. */
-static void lose(tk_pool *p, slot *sl)
-{
-    pthread_mutex_lock(&p->lock);
-    sl->lost = true;
-    if (sl->run)
-        tk_run_cancel(sl->run);
-    pthread_mutex_unlock(&p->lock);
-}
-
-/* The pending frames after the first `fit` are refused (beyond the bytes
- * the job's owner may store): dropped, and counted in the document. */
+/* The pending frames after the first `fit` are refused (beyond the
+ * owner's bytes): dropped, and counted in the document. */
 static void refuse(job_run *jr, size_t fit)
 {
     size_t n = jr->npending - fit;
@@ -131,9 +111,8 @@ static void refuse(job_run *jr, size_t fit)
     pthread_mutex_unlock(&jr->pool->lock);
 }
 
-/* Writes the job as it stands with the parts given, its pending frames
- * while they fit in its owner's bytes: those that do not are refused,
- * and the document saying so written in their place. */
+/* Writes the job with the parts given and the pending frames that fit
+ * in its owner's bytes; the document counts those refused. */
 static int put(job_run *jr, char *const *parts, const json_t *end, tk_error *err)
 {
     size_t fit = 0;
@@ -143,8 +122,8 @@ static int put(job_run *jr, char *const *parts, const json_t *end, tk_error *err
         json_t *doc = tk_slot_doc(jr->slot);
         pthread_mutex_unlock(&jr->pool->lock);
         json_object_update(doc, (json_t *)end);
-        rc = tk_store_put_within(jr->pool->store, doc, (const char *const *)parts, jr->pending,
-                                 jr->stored, jr->npending, jr->pool->cfg.owner_bytes, &fit, err);
+        rc = tk_store_put(jr->pool->store, doc, (const char *const *)parts, jr->pending,
+                          jr->stored, jr->npending, jr->pool->cfg.owner_bytes, &fit, err);
         json_decref(doc);
         if (rc == TK_ELIMIT)
             refuse(jr, fit);
@@ -152,10 +131,9 @@ static int put(job_run *jr, char *const *parts, const json_t *end, tk_error *err
     return rc;
 }
 
-/* Writes the job's document, curve, contacts, history, resume point and
- * new frames in one transaction (NULL run: the document alone).  `end`
- * (or NULL) holds the fields of the job's end: they are written, and
- * shown once written, so no one reads an end the store does not have. */
+/* Writes the job's document, parts and new frames in one transaction
+ * (NULL run: the document alone).  `end` (or NULL): the fields of the
+ * job's end, shown only once written. */
 static int flush(job_run *jr, const json_t *end, tk_error *err)
 {
     char *parts[TK_PARTS] = {NULL};
@@ -179,8 +157,10 @@ static int flush(job_run *jr, const json_t *end, tk_error *err)
         jr->stored += jr->npending;
         while (jr->npending)
             drop_frame(jr);
-    } else if (rc == TK_ENOTFOUND) {
-        lose(jr->pool, jr->slot);
+    } else if (rc == TK_ENOTFOUND) { /* another daemon took it up: stop, unwritten */
+        pthread_mutex_lock(&jr->pool->lock);
+        tk_slot_stop(jr->slot, false);
+        pthread_mutex_unlock(&jr->pool->lock);
     }
     for (int k = 0; k < TK_PARTS; k++)
         free(parts[k]);
@@ -197,13 +177,11 @@ static bool letting_go(job_run *jr, bool ended)
     return go;
 }
 
-/* Writes the job, pausing while the store refuses (see pool.h); `end` as
- * for flush (NULL while it runs).  TK_OK once written; TK_ENOTFOUND when
- * it is held elsewhere now; the store's failure when the pool halts or
- * the job is cancelled before a write succeeds.  The pause, from the
- * first try (a lost server can take seconds to refuse), is added to the
- * job's paused_seconds, and a running job goes on in a run whose clock
- * leaves it out (rebase). */
+/* Writes the job, pausing while the store refuses (pool.h); `end` as for
+ * flush.  TK_OK once written; TK_ENOTFOUND when held elsewhere now; the
+ * store's failure when the pool halts or the job is cancelled first.  The
+ * pause counts from the first try (a lost server can take seconds to
+ * refuse); a running job goes on in a run whose clock leaves it out. */
 static int store_job(job_run *jr, const json_t *end)
 {
     tk_error err;
@@ -257,19 +235,17 @@ static int on_step(const tk_step_report *r, void *user)
     return go;
 }
 
-/* The engine's clock runs from a run's start, a pause of the store
- * included; a job's time budget is for work.  So after a pause the run
- * goes on in a new one resumed from it (tk_run_resume, as after a
- * restart, its clock at its latest step's): the same curve, schedule,
- * escapes and best curve; the history before the resume kept here. */
+/* The engine's clock includes a pause of the store; a job's time budget
+ * is for work.  So after a pause the run goes on in a new one resumed from
+ * it, as after a restart: the same curve, schedule, escapes and best
+ * curve; the history before the resume kept here. */
 static int rebase(job_run *jr, tk_error *err)
 {
     tk_resume at;
     tk_step_report report;
     tk_run_resume_point(jr->run, &at);
-    /* its clock when the pause began: the stop that ended it (which puts
-     * back the escapes' best curve, as a stop before a restart does) may
-     * have measured the curve again since */
+    /* its clock when the pause began: the stop that ended it may have
+     * measured the curve (the escapes' best put back) since */
     at.seconds = fmin(at.seconds, jr->clock);
     const tk_curve *best = tk_run_best(jr->run, &report);
     char *text = tk_record_history(jr->run, jr->before, jr->pool->cfg.history);
@@ -297,8 +273,7 @@ static int rebase(job_run *jr, tk_error *err)
     return TK_OK;
 }
 
-/* A line of the pool's log: the time (UTC, milliseconds), the job, what
- * happened. */
+/* A line of the pool's log: the time, the job, what happened. */
 static void say(tk_pool *p, int64_t id, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 static void say(tk_pool *p, int64_t id, const char *fmt, ...)
@@ -318,8 +293,8 @@ static void say(tk_pool *p, int64_t id, const char *fmt, ...)
 
 /* ---- setting a run up ---- */
 
-/* The engine's run for the job, as the command line would make it: from
- * its input, or from where it was when it was interrupted. */
+/* The job's run as the command line would make it, from its input or
+ * from where it was interrupted. */
 static int setup(job_run *jr, const json_t *doc, tk_error *err)
 {
     tk_curve *input = NULL;

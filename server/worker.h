@@ -42,6 +42,10 @@ struct tk_pool {
  * (made here, not at every step).  Lock held. */
 json_t *tk_slot_doc(const slot *sl);
 
+/* Stops the slot's run within a step: its client cancelled it, or else it
+ * is lost to another daemon.  Lock held. */
+void tk_slot_stop(slot *sl, bool cancel);
+
 /* Runs the job claimed as id in sl to its end, a halt, a cancellation or
  * its loss to another daemon, and stores it (pool.h). */
 void tk_worker_run(slot *sl, int64_t id);

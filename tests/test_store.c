@@ -142,7 +142,7 @@ START_TEST(a_job_reads_back_after_reopening)
     ck_assert_int_eq(tk_job_options_of(doc, &o, &err), TK_OK);
     ck_assert_int_eq(o.run.max_steps, 77);
     /* only the holder writes: a job not claimed is not */
-    ck_assert_int_eq(tk_store_put(s, doc, NULL, NULL, 0, 0, &err), TK_ENOTFOUND);
+    ck_assert_int_eq(tk_store_put(s, doc, NULL, NULL, 0, 0, 0, NULL, &err), TK_ENOTFOUND);
     ck_assert_int_eq(tk_store_claim(s, &claimed, &err), TK_OK);
     ck_assert_int_eq(claimed, id);
     tk_job_set_figures(doc, &r, &o);
@@ -150,7 +150,7 @@ START_TEST(a_job_reads_back_after_reopening)
     const char *parts[TK_PARTS] = {NULL, "VECT curve", "{\"struts\":[]}", "[1,2]", "{}"};
     double xyz[2][6] = {{0.1, 1.0 / 3.0, -2.5, 4, 5, 6}, {1e-300, 2, 3, 4, 5, 6}};
     tk_frame frames[2] = {{10, xyz[0], 6, "[2]"}, {20, xyz[1], 6, NULL}};
-    ck_assert_int_eq(tk_store_put(s, doc, parts, frames, 0, 2, &err), TK_OK);
+    ck_assert_int_eq(tk_store_put(s, doc, parts, frames, 0, 2, 0, NULL, &err), TK_OK);
     tk_frame *f = NULL;
     size_t n = 0;
     ck_assert_int_eq(tk_store_frames(s, id, 1, 10, &f, &n, &err), TK_OK);
@@ -164,8 +164,8 @@ START_TEST(a_job_reads_back_after_reopening)
      * running lets go of the job */
     frames[0].step = 15;
     json_object_set_new(doc, "state", json_string("done"));
-    ck_assert_int_eq(tk_store_put(s, doc, NULL, frames, 1, 1, &err), TK_OK);
-    ck_assert_int_eq(tk_store_put(s, doc, NULL, NULL, 0, 0, &err), TK_ENOTFOUND);
+    ck_assert_int_eq(tk_store_put(s, doc, NULL, frames, 1, 1, 0, NULL, &err), TK_OK);
+    ck_assert_int_eq(tk_store_put(s, doc, NULL, NULL, 0, 0, 0, NULL, &err), TK_ENOTFOUND);
     tk_store_close(&s);
 
     s = open_store();
@@ -205,7 +205,7 @@ START_TEST(a_running_job_is_its_holders)
     ck_assert_int_eq(claimed, id);
     json_t *doc = get(b, id);
     ck_assert_str_eq(json_string_value(json_object_get(doc, "state")), "running");
-    ck_assert_int_eq(tk_store_put(b, doc, NULL, NULL, 0, 0, &err), TK_ENOTFOUND);
+    ck_assert_int_eq(tk_store_put(b, doc, NULL, NULL, 0, 0, 0, NULL, &err), TK_ENOTFOUND);
     ck_assert_int_eq(tk_store_renew(b, id, &cancel, &err), TK_ENOTFOUND);
     ck_assert_int_eq(tk_store_renew(a, id, &cancel, &err), TK_OK);
     ck_assert(!cancel);
@@ -213,9 +213,9 @@ START_TEST(a_running_job_is_its_holders)
     ck_assert_int_eq(tk_store_stop(b, id, &err), TK_OK);
     ck_assert_int_eq(tk_store_renew(a, id, &cancel, &err), TK_OK);
     ck_assert(cancel);
-    ck_assert_int_eq(tk_store_put(a, doc, NULL, NULL, 0, 0, &err), TK_OK);
+    ck_assert_int_eq(tk_store_put(a, doc, NULL, NULL, 0, 0, 0, NULL, &err), TK_OK);
     json_object_set_new(doc, "state", json_string("cancelled"));
-    ck_assert_int_eq(tk_store_put(a, doc, NULL, NULL, 0, 0, &err), TK_OK);
+    ck_assert_int_eq(tk_store_put(a, doc, NULL, NULL, 0, 0, 0, NULL, &err), TK_OK);
     ck_assert_int_eq(tk_store_stop(b, id, &err), TK_EINVAL); /* ended */
     ck_assert_int_eq(tk_store_renew(a, id, &cancel, &err), TK_ENOTFOUND);
     ck_assert_str_eq(state_of(b, id), "cancelled");
@@ -243,9 +243,9 @@ START_TEST(a_lapsed_claim_goes_to_another_store)
     ck_assert_int_eq(tk_store_claim(b, &got, &err), TK_OK);
     ck_assert_int_eq(got, id);
     json_t *doc = get(a, id);
-    ck_assert_int_eq(tk_store_put(a, doc, NULL, NULL, 0, 0, &err), TK_ENOTFOUND);
+    ck_assert_int_eq(tk_store_put(a, doc, NULL, NULL, 0, 0, 0, NULL, &err), TK_ENOTFOUND);
     ck_assert_int_eq(tk_store_renew(a, id, &cancel, &err), TK_ENOTFOUND);
-    ck_assert_int_eq(tk_store_put(b, doc, NULL, NULL, 0, 0, &err), TK_OK);
+    ck_assert_int_eq(tk_store_put(b, doc, NULL, NULL, 0, 0, 0, NULL, &err), TK_OK);
     /* a daemon's start leaves running jobs to their leases */
     ck_assert_int_eq(tk_store_requeue(a, &err), TK_OK);
     ck_assert_str_eq(state_of(a, id), "running");
@@ -423,13 +423,13 @@ START_TEST(an_owner_limit_counts_its_stored_bytes)
     json_t *running = get(s, first);
     double *xyz = calloc(3 * 43691, sizeof *xyz);
     tk_frame f = {0, xyz, 3 * 43691, NULL};
-    ck_assert_int_eq(tk_store_put(s, running, NULL, &f, 0, 1, &err), TK_OK);
+    ck_assert_int_eq(tk_store_put(s, running, NULL, &f, 0, 1, 0, NULL, &err), TK_OK);
     ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 0, 1000000}, &err),
                      TK_EBUSY);
     ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 0, 1100000}, &err),
                      TK_OK);
     json_object_set_new(running, "state", json_string("done"));
-    ck_assert_int_eq(tk_store_put(s, running, NULL, NULL, 1, 0, &err), TK_OK); /* frame kept */
+    ck_assert_int_eq(tk_store_put(s, running, NULL, NULL, 1, 0, 0, NULL, &err), TK_OK); /* frame kept */
     ck_assert_int_eq(tk_store_add(s, doc, input, &(tk_store_limits){1000, 0, 1000000}, &err),
                      TK_EBUSY); /* ended, but still stored */
     ck_assert_int_eq(tk_store_delete(s, first, &err), TK_OK);
