@@ -248,14 +248,12 @@ int tk_api_start(const tk_api_config *cfg, tk_pool *pool, tk_store *store, tk_ap
     if (!a)
         return tk_error_set(err, TK_ENOMEM, "out of memory");
     *a = (tk_api){.cfg = *cfg, .pool = pool, .store = store, .started = time(NULL)};
-    if (tk_limits_start(a, err)) {
-        tk_api_stop(&a);
-        return TK_ENOMEM;
-    }
+    int rc = tk_limits_start(a, err);
+    if (rc)
+        goto done;
     if (cfg->web && !(a->web = realpath(cfg->web, NULL))) {
-        tk_error_set(err, TK_EIO, "--web: cannot use %s: %s", cfg->web, strerror(errno));
-        tk_api_stop(&a);
-        return TK_EIO;
+        rc = tk_error_set(err, TK_EIO, "--web: cannot use %s: %s", cfg->web, strerror(errno));
+        goto done;
     }
     if (cfg->catalogue)
         a->catalogue = tk_catalogue_load(cfg->catalogue);
@@ -264,17 +262,17 @@ int tk_api_start(const tk_api_config *cfg, tk_pool *pool, tk_store *store, tk_ap
     if (asprintf(&a->hosts, "%s,localhost%s%s", any ? "127.0.0.1" : cfg->bind,
                  cfg->hosts ? "," : "", cfg->hosts ? cfg->hosts : "") < 0) {
         a->hosts = NULL;
-        tk_api_stop(&a);
-        return tk_error_set(err, TK_ENOMEM, "out of memory");
+        rc = tk_error_set(err, TK_ENOMEM, "out of memory");
+        goto done;
     }
     size_t len = 0;
     if (!cfg->tls_cert != !cfg->tls_key ||
         (cfg->tls_cert && (!(a->tls_cert = slurp(cfg->tls_cert, &len)) ||
                            !(a->tls_key = slurp(cfg->tls_key, &len))))) {
-        tk_error_set(err, TK_EIO, "--tls-cert and --tls-key: %s", cfg->tls_cert && cfg->tls_key
-                     ? "cannot read both files" : "give both, or neither");
-        tk_api_stop(&a);
-        return TK_EIO;
+        rc = tk_error_set(err, TK_EIO, "--tls-cert and --tls-key: %s",
+                          cfg->tls_cert && cfg->tls_key ? "cannot read both files"
+                                                        : "give both, or neither");
+        goto done;
     }
     struct MHD_OptionItem tls[] = {{MHD_OPTION_HTTPS_MEM_CERT, 0, a->tls_cert},
                                    {MHD_OPTION_HTTPS_MEM_KEY, 0, a->tls_key},
@@ -289,16 +287,16 @@ int tk_api_start(const tk_api_config *cfg, tk_pool *pool, tk_store *store, tk_ap
         (unsigned)cfg->max_per_address, MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg->timeout,
         MHD_OPTION_NOTIFY_COMPLETED, request_done, a, MHD_OPTION_LISTEN_BACKLOG_SIZE, 1024,
         MHD_OPTION_NOTIFY_CONNECTION, tk_limits_notify, a, MHD_OPTION_END);
-    if (!a->daemon) {
-        tk_error_set(err, TK_EIO, "cannot listen on %s:%zu: %s", cfg->bind, cfg->port,
-                     errno ? strerror(errno)
-                           : a->tls_cert ? "the TLS certificate or key was refused"
-                                         : "unknown error");
+    if (!a->daemon)
+        rc = tk_error_set(err, TK_EIO, "cannot listen on %s:%zu: %s", cfg->bind, cfg->port,
+                          errno ? strerror(errno)
+                                : a->tls_cert ? "the TLS certificate or key was refused"
+                                              : "unknown error");
+done:
+    if (rc)
         tk_api_stop(&a);
-        return TK_EIO;
-    }
     *out = a;
-    return TK_OK;
+    return rc;
 }
 
 unsigned tk_api_port(const tk_api *a)

@@ -21,8 +21,8 @@ static bool visible(const request *rq, const json_t *doc)
     return !rq->who || rq->admin || (owner && !strcmp(owner, rq->who));
 }
 
-/* A problem for an error of the engine or the reader: a VECT error names
- * its line ("line 3: ..."). */
+/* A problem for an error of the engine or the reader, with the line a
+ * VECT error names ("line 3: ..."). */
 static result input_problem(tk_api *a, conn *c, const tk_error *err)
 {
     int line = 0;
@@ -31,8 +31,7 @@ static result input_problem(tk_api *a, conn *c, const tk_error *err)
     return problem(a, c, 422, extra, NULL, "%s", err->message);
 }
 
-/* A stored text that does not read back as written: 500, and health says
- * the store is damaged. */
+/* A stored text that does not read back: 500, and health says so. */
 static result damaged(tk_api *a, conn *c, int64_t id, const char *what, const char *why)
 {
     char message[TK_ERROR_MESSAGE_SIZE];
@@ -62,13 +61,20 @@ static int get_job(tk_api *a, int64_t id, json_t **doc, tk_error *err)
     return *doc ? TK_OK : tk_store_get(a->store, id, doc, err);
 }
 
+/* The page a listing asks for: ?offset (0 on) and ?limit (1 to most). */
+static bool paging(tk_api *a, conn *c, long dflt, long most, long *offset, long *limit,
+                   result *ret)
+{
+    return query_count(a, c, "offset", 0, 0, LONG_MAX, offset, ret) &&
+           query_count(a, c, "limit", dflt, 1, most, limit, ret);
+}
+
 static result list_jobs(tk_api *a, conn *c, const call *k)
 {
     const request *rq = k->rq;
     result ret = MHD_NO;
     long offset, limit;
-    if (!query_count(a, c, "offset", 0, 0, LONG_MAX, &offset, &ret) ||
-        !query_count(a, c, "limit", 50, 1, 500, &limit, &ret))
+    if (!paging(a, c, 50, 500, &offset, &limit, &ret))
         return ret;
     const char *name = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "state");
     int state = name ? tk_job_state_of(name) : -1;
@@ -94,7 +100,6 @@ static result list_jobs(tk_api *a, conn *c, const call *k)
                                           (json_int_t)total, "offset", (json_int_t)offset,
                                           "limit", (json_int_t)limit), NULL, NULL);
 }
-
 
 typedef struct query_list {
     tk_query_pair pairs[64];
@@ -314,8 +319,7 @@ static result get_frames(tk_api *a, conn *c, const call *k)
     const json_t *doc = k->doc;
     result ret = MHD_NO;
     long offset, limit;
-    if (!query_count(a, c, "offset", 0, 0, LONG_MAX, &offset, &ret) ||
-        !query_count(a, c, "limit", 20, 1, 200, &limit, &ret))
+    if (!paging(a, c, 20, 200, &offset, &limit, &ret))
         return ret;
     /* a page holds at most 10^6 coordinates, however large the knot */
     long per = 3 * (long)json_integer_value(json_object_get(doc, "vertices"));
@@ -359,7 +363,6 @@ static result get_frames(tk_api *a, conn *c, const call *k)
                      NULL, NULL);
 }
 
-
 static result get_one(tk_api *a, conn *c, const call *k)
 {
     return send_json(a, c, 200, with_links(json_incref((json_t *)k->doc)), NULL, NULL);
@@ -378,12 +381,11 @@ static result preflight(tk_api *a, conn *c, const call *k)
 /* ---- the route table ---- */
 
 /* One row per operation of openapi.yaml (tests/service/routes.test.mjs
- * holds the two to each other): its method and path, its operationId,
- * whether it needs a token (with --tokens: all but the page, health and a
- * preflight, which browsers send without credentials), and whether it
- * reads the job first (a GET of {id}: another name's job is not there).
- * "/" is the page and every file beside it: any path outside /v1 and
- * /metrics. */
+ * holds the two to each other): method, path, operationId, whether it
+ * needs a token (with --tokens: all but the page, health and a preflight,
+ * which browsers send without credentials), and whether it reads the job
+ * first (another name's job is not there).  "/" is the page and every
+ * file beside it: any path outside /v1 and /metrics. */
 typedef struct route {
     const char *method, *path, *operation;
     handler *fn;
@@ -464,11 +466,11 @@ result tk_route(tk_api *a, conn *c, const call *k)
                            "numbers)", url);
     }
     const route *r = strcmp(k->method, "OPTIONS") ? find(k->method, url, &arg) : NULL;
-    if (r && r->job) {
+    if (r) {
         json_t *doc = NULL;
         tk_error err;
-        int rc = get_job(a, at.id, &doc, &err);
-        if (!rc && !visible(k->rq, doc)) { /* another name's: not there for this one */
+        int rc = r->job ? get_job(a, at.id, &doc, &err) : TK_OK;
+        if (!rc && r->job && !visible(k->rq, doc)) { /* another name's: not there for this one */
             json_decref(doc);
             rc = tk_error_set(&err, TK_ENOTFOUND, "there is no job %lld", (long long)at.id);
         }
@@ -479,10 +481,6 @@ result tk_route(tk_api *a, conn *c, const call *k)
         result ret = r->fn(a, c, &at);
         json_decref(doc);
         return ret;
-    }
-    if (r) {
-        at.arg = arg;
-        return r->fn(a, c, &at);
     }
     /* the path's other methods, or none: 405 or 404 */
     char allow[64] = "";
