@@ -1,9 +1,6 @@
-/* tightknot service: the HTTP routes (openapi.yaml is their contract).
- *
- * libmicrohttpd answers on its own threads.  A request reads the store
- * and the pool; POST checks what it can without the engine (the body, the
- * VECT with its limits, the options' domains) and queues the job; the
- * worker sets the run up, and a start it cannot tighten fails the job.
+/* tightknot service: the HTTP API (openapi.yaml is its contract).
+ * Requests never run the engine: POST checks what it can without it (the
+ * body, the VECT and its limits, the options' domains) and queues the job.
  */
 #ifndef TK_SERVER_API_H
 #define TK_SERVER_API_H
@@ -42,10 +39,9 @@ size_t tk_api_catalogue_size(const tk_api *a);
 void tk_api_refuse(tk_api *a); /* from now on every request gets 503 */
 void tk_api_stop(tk_api **p);
 
-/* A POST /v1/jobs as decoded, without HTTP and without the engine: the
- * name, the options, and either the VECT text (not yet parsed, so that
- * its errors name their line; it points into the body or into `json`) or
- * a catalogue entry's name. */
+/* A POST /v1/jobs decoded, without HTTP or the engine: name, options,
+ * and the VECT text (unparsed, in the body or `json`) or a catalogue
+ * entry's name. */
 typedef struct tk_query_pair {
     const char *key, *value; /* value NULL: no '=' */
     bool nul;                /* either held a NUL byte (decoded %00) */
@@ -58,9 +54,8 @@ typedef struct tk_submission {
     json_t *json; /* the body when it was JSON */
 } tk_submission;
 
-/* Why a submission is refused: 400 (not JSON), 415 (media type) or 422,
- * the detail, and the member naming the culprit ("field", "option",
- * "parameter"; "" when none) with its value. */
+/* Why a submission is refused (400, 415 or 422), and the member naming
+ * the culprit ("field", "option", "parameter"; "": none) with its value. */
 typedef struct tk_problem {
     unsigned status;
     char detail[512], member[16], value[64];

@@ -4,12 +4,10 @@
  *   alice   sha256:2bb80d537b1da3e38bd30361aa855686bde0eacd7162fef6a25fe97bf527a25b
  *   bob     s3cret-bob-token                                 admin
  *
- * A token is given as it is (at least TK_TOKEN_MIN characters) or as
- * "sha256:" and the 64 hex digits of its SHA-256, so that the file need
- * hold no secret; only the hashes are kept.  A line whose first
- * non-blank character is '#' is a comment; a '#' elsewhere belongs to the
- * token.
- * A request names its client with "Authorization: Bearer TOKEN".
+ * A token as it is (at least TK_TOKEN_MIN characters) or as "sha256:" and
+ * its SHA-256 in hex, so the file need hold no secret; only hashes are
+ * kept.  A '#' first on a line makes a comment, elsewhere it is the
+ * token's.  A request sends "Authorization: Bearer TOKEN".
  */
 #ifndef TK_SERVER_AUTH_H
 #define TK_SERVER_AUTH_H

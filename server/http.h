@@ -1,6 +1,5 @@
-/* tightknot service: the HTTP layer (http.c) as the routes (routes.c) and
- * the modules beside them (boundary, limits, catalogue, static files,
- * metrics) see it: the daemon's state, a request, and the answers. */
+/* tightknot service: the HTTP layer (http.c) as the routes and the
+ * modules beside them see it: the daemon's state, a request, answers. */
 #ifndef TK_SERVER_HTTP_H
 #define TK_SERVER_HTTP_H
 
@@ -42,8 +41,8 @@ typedef struct request {
     bool admin;
 } request;
 
-/* What a route's handler is given: the request, its URL, the path's
- * parameter ({id} as id, {name} as arg) and, for a job's GET, the job. */
+/* A route handler's request, URL, path parameter ({id} as id, {name} as
+ * arg) and, for a job's GET, the job. */
 typedef struct call {
     const request *rq;
     const char *url, *method, *arg;
@@ -52,14 +51,14 @@ typedef struct call {
 } call;
 typedef result handler(tk_api *a, conn *c, const call *k);
 
-/* The route table's dispatch: the answer to a request whose head passed
- * the boundary and the token check.  Whether (method, url) needs a token. */
+/* The answer to a request whose head passed the boundary and the token
+ * check; whether (method, url) needs a token. */
 result tk_route(tk_api *a, conn *c, const call *k);
 bool tk_route_needs_token(const char *method, const char *url);
 
-/* Answers.  send_buffer takes buf (len bytes) and adds headers (name,
- * value, ..., NULL); problem sends an RFC 9457 problem, `extra` (taken, or
- * NULL) adding members such as "line" or "option". */
+/* Answers: send_buffer takes buf and adds headers (name, value, ...,
+ * NULL); problem sends an RFC 9457 problem, `extra` (taken, or NULL)
+ * adding members such as "line". */
 result send_buffer(tk_api *a, conn *c, unsigned status, const char *type, char *buf, size_t len,
                    const char *const *headers);
 result send_json(tk_api *a, conn *c, unsigned status, json_t *o, const char *type,
@@ -68,24 +67,23 @@ __attribute__((format(printf, 6, 7))) result problem(tk_api *a, conn *c, unsigne
                                                      json_t *extra, const char *const *headers,
                                                      const char *fmt, ...);
 #define PROBLEM(a, c, status, ...) problem(a, c, status, NULL, NULL, __VA_ARGS__)
-/* A store that cannot be reached or written (TK_EIO) is an outage: 503
- * and when to try again; not found is 404, else 500. */
+/* TK_EIO is an outage: 503 and when to try again; not found 404; else 500. */
 result store_problem(tk_api *a, conn *c, int rc, const tk_error *err);
-/* Reads a whole-number query parameter in [lo, hi] (dflt when absent);
- * false when it is malformed (then *ret is the 400 sent). */
+/* A whole-number query parameter in [lo, hi] (dflt when absent); false
+ * when malformed, *ret the 400 sent. */
 bool query_count(tk_api *a, conn *c, const char *name, long dflt, long lo, long hi, long *out,
                  result *ret);
 /* A file's whole text (NUL-terminated), or NULL. */
 char *slurp(const char *path, size_t *len);
 
-/* The browser boundary (boundary.c): 0 when the request may pass, else the
- * status to refuse it with (400, 421 or 403), with why; the allowed other
- * origin the request comes from, or NULL. */
+/* The browser boundary (boundary.c): 0 when the request may pass, else
+ * the status (400, 421, 403) and why; the allowed other origin it comes
+ * from, or NULL. */
 unsigned tk_boundary(const tk_api *a, conn *c, const char *version, char *why, size_t size);
 const char *tk_allowed_origin(const tk_api *a, conn *c);
 
-/* The page's files (static.c), the catalogue (catalogue.c), health and
- * metrics (metrics.c): handlers of the route table. */
+/* Handlers of the page's files (static.c), the catalogue, health and
+ * metrics. */
 handler tk_get_static, tk_get_catalogue, tk_list_catalogue, tk_get_health, tk_get_metrics;
 /* Reads the catalogue's *.vect files once; NULL when there are none. */
 catalogue *tk_catalogue_load(const char *dir);
@@ -101,15 +99,14 @@ size_t tk_limits_held(const tk_api *a); /* bytes of bodies held now */
 /* Names rq's client, once its token is checked. */
 void tk_limits_client(conn *c, request *rq);
 /* Takes `more` bytes of the budget for rq's client: 0, or the budget that
- * refuses them (request.crowded). */
+ * refuses them. */
 int tk_limits_reserve(tk_api *a, const request *rq, size_t more);
 void tk_limits_release(tk_api *a, const request *rq, size_t bytes);
 size_t tk_limits_share(const tk_api *a); /* what one client may hold */
-/* The connection's deadline (ms, monotonic; 0: none), and the head's:
- * --head-timeout from now. */
+/* The connection's deadline (ms, monotonic; 0: none); --head-timeout on. */
 void tk_limits_due(conn *c, long long due);
 long long tk_limits_head_due(const tk_api *a);
-/* libmicrohttpd's connection notices: a connection is watched while open. */
+/* Watches a connection while it is open. */
 void tk_limits_notify(void *cls, conn *c, void **context, enum MHD_ConnectionNotificationCode code);
 
 #endif

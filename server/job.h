@@ -1,15 +1,11 @@
-/* tightknot service: a job is one JSON document.
- *
- * The document is what GET /v1/jobs/{id} serves (openapi.yaml, Job) less
- * its links: what was asked (name, options) and by whom (owner: the name
- * of its token, null without tokens), where the job stands (state,
- * progress, timestamps, stop reason, error, frames, knot type) and its
- * latest figures, which are the fields of the engine's step report under
- * their table's names (tk/tighten.h); what the store did to it: frames
- * refused (frames_refused: beyond its owner's bytes) and the seconds it
- * was paused by a failing store (paused_seconds, not spent of its time
- * budget).  The store keeps it as it is, the
- * pool updates it, the routes serve it: no field is listed twice.
+/* tightknot service: a job is one JSON document, what GET /v1/jobs/{id}
+ * serves (openapi.yaml, Job) less its links: what was asked (name,
+ * options) and by whom (owner: its token's name, or null), where it
+ * stands (state, progress, timestamps, stop reason, error, frames, knot
+ * type), its latest figures (the step report's fields, tk/tighten.h), and
+ * what the store did to it (frames_refused, paused_seconds).  The store
+ * keeps it, the pool updates it, the routes serve it: no field is listed
+ * twice.
  */
 #ifndef TK_SERVER_JOB_H
 #define TK_SERVER_JOB_H
@@ -51,8 +47,8 @@ void tk_time_iso(char out[32]);
 /* Seconds on the monotonic clock: for spans and deadlines. */
 double tk_clock_seconds(void);
 
-/* The index of the i-th of `keep` entries taken evenly from n (keep >= 2
- * takes the first and the last): how a history is thinned. */
+/* The index of the i-th of `keep` entries taken evenly from n, the first
+ * and the last among them: how a history is thinned. */
 size_t tk_job_thin(size_t i, size_t n, size_t keep);
 
 /* The job's state, step and id as the document says. */
