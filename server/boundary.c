@@ -32,14 +32,13 @@ static result count_host(void *cls, enum MHD_ValueKind kind, const char *key, co
     return MHD_YES;
 }
 
-/* A page in a browser can send requests to any address, loopback too:
- * with a name of its own that resolves here (DNS rebinding) it can even
- * read the answers.  So the Host a request names must be one this daemon
- * serves, and a request a page sends (it carries an Origin) must come from
- * the daemon's own origin (the page it serves) or one allowed with
- * --allow-origin, scheme and all.  An HTTP/1.1 request names exactly one
- * Host (RFC 9112, 3.2): with none or two, which one a proxy in front and
- * this daemon each read is not the same. */
+/* A page in a browser can send requests to any address, loopback too,
+ * and read the answers under a name of its own that resolves here (DNS
+ * rebinding).  So the Host must be one this daemon serves, and a page's
+ * request (with an Origin) must come from the daemon's own origin or one
+ * allowed with --allow-origin, scheme and all.  An HTTP/1.1 request names
+ * exactly one Host (RFC 9112, 3.2): with none or two, a proxy in front
+ * and this daemon may each read another. */
 unsigned tk_boundary(const tk_api *a, conn *c, const char *version, char *why, size_t size)
 {
     const char *host = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);

@@ -28,10 +28,8 @@ static int by_name(const void *x, const void *y)
 /* The entry called name, or NULL. */
 static const entry *find(const catalogue *cat, const char *name)
 {
-    for (size_t i = 0; cat && i < cat->n; i++)
-        if (!strcmp(cat->entries[i].name, name))
-            return &cat->entries[i];
-    return NULL;
+    entry key = {.name = (char *)name};
+    return cat ? bsearch(&key, cat->entries, cat->n, sizeof key, by_name) : NULL;
 }
 
 static char *read_text(const char *dir, const char *name, size_t *len)
@@ -78,14 +76,13 @@ catalogue *tk_catalogue_load(const char *dir)
 
 void tk_catalogue_free(catalogue **p)
 {
-    for (size_t i = 0; p && *p && i < (*p)->n; i++)
+    if (!p || !*p)
+        return;
+    for (size_t i = 0; i < (*p)->n; i++)
         free((*p)->entries[i].name);
-    if (p && *p)
-        free((*p)->entries);
-    if (p) {
-        free(*p);
-        *p = NULL;
-    }
+    free((*p)->entries);
+    free(*p);
+    *p = NULL;
 }
 
 size_t tk_catalogue_size(const catalogue *cat)

@@ -1,6 +1,5 @@
-/* tightknot service: what one client may take of the others (see
- * http.h): its share of the upload budget, and the deadlines of a
- * request's head and body. */
+/* tightknot service: what one client may take of the others (http.h):
+ * its share of the upload budget, and the deadlines of head and body. */
 #include "http.h"
 
 #include <arpa/inet.h>
@@ -23,13 +22,12 @@ struct limits {
     atomic_bool stopping;
 };
 
-/* The body budget's shares.  A client is the name of the token its
- * request carries (clients behind one address, a NAT, get a share each; a
- * name on many addresses is still one), else its address.  It holds at
- * most a quarter of --max-body-total, or one body of --max-body where that
- * is more: one client holding slow uploads leaves the others three
- * quarters (the probe's four 16 MB uploads took it all), yet can always
- * send one largest body. */
+/* The body budget's shares.  A client is its token's name (clients
+ * behind one NAT get a share each; a name on many addresses is one), else
+ * its address.  It holds at most a quarter of --max-body-total, or one
+ * --max-body where that is more: slow uploads of one client leave the
+ * others three quarters (the probe's four 16 MB uploads took it all), yet
+ * it can always send one largest body. */
 typedef struct holder {
     char client[72];
     size_t bytes;
@@ -96,19 +94,16 @@ void tk_limits_client(conn *c, request *rq)
     snprintf(rq->client, sizeof rq->client, "%c%s", rq->who ? 'n' : 'a', rq->who ? rq->who : addr);
 }
 
-/* Deadlines.  --timeout counts only silence: a client sending a header
- * line every few seconds kept its connection for ever, and 8 addresses x
- * 128 of them held every slot (the probe's F12).  libmicrohttpd 0.9.75
- * has only idle timeouts, and calls us once a head is whole, so we keep
- * them: each connection, watched from its start (NOTIFY_CONNECTION), is
- * due to have its head within --head-timeout of its opening or of its
- * previous answer, then to keep its body up to --min-body-rate (handle),
- * and is due nothing while it is answered.  A thread looks
- * every 200 ms and cuts those past due with shutdown(): libmicrohttpd's
- * thread then reads the end of input and closes the connection as one
- * the client closed (it has no way for us to answer 408 before a head is
- * whole).  A watch leaves the list before libmicrohttpd closes its
- * socket, so under the lock its descriptor is still its own. */
+/* Deadlines.  --timeout counts only silence: a header line every few
+ * seconds kept a connection for ever, and 8 addresses x 128 held every
+ * slot (the probe's F12).  libmicrohttpd 0.9.75 has only idle timeouts,
+ * so we keep them: each connection is due to have its head within
+ * --head-timeout of its opening or previous answer, then to keep its body
+ * up to --min-body-rate (handle), and nothing while it is answered.  A
+ * thread cuts those past due every 200 ms with shutdown(), which
+ * libmicrohttpd reads as the client closing (it cannot answer 408 before
+ * a head is whole).  A watch leaves the list before libmicrohttpd closes
+ * its socket, so under the lock its descriptor is still its own. */
 typedef struct watch {
     struct watch *prev, *next;
     int fd;
@@ -178,7 +173,6 @@ static void *keep_deadlines(void *cls)
     }
     return NULL;
 }
-
 
 int tk_limits_start(tk_api *a, tk_error *err)
 {

@@ -153,9 +153,7 @@ static result post_job(tk_api *a, conn *c, const call *k)
     /* what is known without the engine: the text, its limits, the
      * magnitudes the engine measures in, the options together */
     if (tk_vect_parse(sub.vect, sub.len, &bounds, &curve, &err) ||
-        tk_curve_check_range(curve, &err)) {
-        ret = input_problem(a, c, &err);
-    } else if (tk_options_check(&sub.options.run, &err)) {
+        tk_curve_check_range(curve, &err) || tk_options_check(&sub.options.run, &err)) {
         ret = input_problem(a, c, &err);
     } else if (sub.options.run.vertices > a->cfg.max_vertices) {
         ret = problem(a, c, 422, json_pack("{s:s}", "option", "vertices"), NULL, "option "
