@@ -5,7 +5,9 @@
 // For each knot or link of the slice it makes starts of different shapes
 // with the catalogue file's type (checked with `tightknot info` before
 // any is submitted): the catalogue file itself, far deformations of it
-// (`tightknot generate deform`, one per seed), and the parametric forms
+// (`tightknot generate deform`, one per seed), the file turned inside out
+// (`tightknot generate turn`: about its centroid, then points near it,
+// one per seed), and the parametric forms
 // whose type is the file's (torus knots and links, chains).  They are
 // tightened with the same settings; the results land in OUT/results
 // (the client's summary.tsv and one VECT and contacts file a start), and
@@ -29,7 +31,8 @@
 //   --slice K/N       the K-th of N slices (default 1/1: all)
 //   --seconds S       wall time per start (default 60)
 //   --resolution R    vertices per unit ropelength (default 5)
-//   --far K           far deformations per knot, seeds 1..K (default 2)
+//   --far K           far deformations per knot, seeds 1..K (default 1)
+//   --turn K          turned starts per knot, seeds 0..K-1 (default 1)
 //   --parallel N      starts running at once (default: the cores)
 //   --out DIR         work directory (default build/catalogue)
 //   --table FILE      the table (default docs/catalogue.tsv)
@@ -45,7 +48,7 @@ import { join, resolve } from 'node:path';
 const argv = process.argv.slice(2);
 const opt = {
     server: null, token: process.env.TIGHTKNOT_TOKEN ?? null, slice: '1/1', seconds: 60,
-    resolution: 5, far: 2, parallel: cpus().length, out: 'build/catalogue',
+    resolution: 5, far: 1, turn: 1, parallel: cpus().length, out: 'build/catalogue',
     table: 'docs/catalogue.tsv', build: 'build', only: null, tableOnly: false,
     catalogue: '../shared/catalogue',
 };
@@ -61,6 +64,7 @@ for (let i = 0; i < argv.length; i++) {
     else if (a === '--seconds') opt.seconds = Number(value());
     else if (a === '--resolution') opt.resolution = Number(value());
     else if (a === '--far') opt.far = Number(value());
+    else if (a === '--turn') opt.turn = Number(value());
     else if (a === '--parallel') opt.parallel = Number(value());
     else if (a === '--out') opt.out = value();
     else if (a === '--table') opt.table = value();
@@ -76,6 +80,7 @@ if (!slice || +slice[1] < 1 || +slice[1] > +slice[2]) usage(`--slice ${opt.slice
 for (const k of ['seconds', 'resolution', 'parallel'])
     if (!(opt[k] > 0)) usage(`--${k} must be positive`);
 if (!(Number.isInteger(opt.far) && opt.far >= 0)) usage('--far must be a whole number >= 0');
+if (!(Number.isInteger(opt.turn) && opt.turn >= 0)) usage('--turn must be a whole number >= 0');
 
 function usage(why) {
     const text = readFileSync(new URL(import.meta.url), 'utf8').split('\n');
@@ -165,6 +170,11 @@ function makeStarts(name) {
         const r = spawnSync(CLI, ['generate', 'deform', file, String(s)], { encoding: 'utf8' });
         if (r.status === 0) put(`far${s}`, r.stdout, `deformation ${s}`);
         else console.log(`  ${name}: no deformation ${s}: ${r.stderr.trim()}`);
+    }
+    for (let s = 0; s < opt.turn; s++) {
+        const r = spawnSync(CLI, ['generate', 'turn', file, String(s)], { encoding: 'utf8' });
+        if (r.status === 0) put(`turn${s}`, r.stdout, `turned start ${s}`);
+        else console.log(`  ${name}: no turned start ${s}: ${r.stderr.trim()}`);
     }
     for (const p of parametric(name)) {
         const r = spawnSync(CLI, ['generate', ...p], { encoding: 'utf8' });

@@ -99,12 +99,12 @@ json_t *tk_json_escapes(const tk_escape *e, size_t count)
     json_t *list = json_array();
     for (size_t k = 0; list && k < count; k++)
         json_array_append_new(
-            list, json_pack("{s:I, s:o, s:o, s:o, s:o, s:b, s:b}", "step", (json_int_t)e[k].step,
+            list, json_pack("{s:I, s:o, s:o, s:o, s:o, s:b, s:b, s:b}", "step", (json_int_t)e[k].step,
                             "from", tk_json_number(e[k].from), "amplitude",
                             tk_json_number(e[k].amplitude), "coarse",
                             tk_json_number(e[k].coarse), "reached",
                             tk_json_number(e[k].reached), "improved", e[k].improved,
-                            "explored", e[k].explored));
+                            "explored", e[k].explored, "turned", e[k].turned));
     return list;
 }
 

@@ -1422,7 +1422,8 @@ START_TEST(escapes_keep_the_best_and_repeat)
     for (size_t k = 0; k < ne; k++) {
         printf("escape %zu after step %ld: from %.6f, amplitude %.4f, reached %.6f\n", k,
                e[k].step, e[k].from, e[k].amplitude, e[k].reached);
-        ck_assert(e[k].amplitude > 0.0 && e[k].amplitude <= 1.0);
+        ck_assert(e[k].turned ? e[k].amplitude == 0.0
+                              : e[k].amplitude > 0.0 && e[k].amplitude <= 1.0);
         ck_assert(end->ropelength <= e[k].from * (1.0 + 1e-12));
         if (!isnan(e[k].reached))
             ck_assert(end->ropelength <= e[k].reached * (1.0 + 1e-12));
@@ -2273,10 +2274,12 @@ START_TEST(a_try_behind_on_its_coarsest_polygon_is_given_up_there)
     o.autoscale = true;
     o.vertices = 200;
     o.escapes = 8;
-    o.seed = 3; /* seed 1's tries are all behind the lowest explored curve */
+    o.seed = 3;
     /* polished on its coarse polygon, every try ends in the lineage's
-     * basin, its figure within 3e-5 of the lineage's: seed 3's sixth is
-     * the first a hair below it */
+     * basin, its figure within 3e-5 of the lineage's; since the tries
+     * turn the curve inside out in turn, the lowest explored curve (seed
+     * 3's turned one) is lower than every later try's in seeds 1 to 16,
+     * so that the branch that refines a try is not always taken here */
     o.max_steps = 30000;
     tk_run *run = NULL;
     tk_error err;
@@ -2343,7 +2346,6 @@ START_TEST(a_try_behind_on_its_coarsest_polygon_is_given_up_there)
     printf("T(2,3) at 200 vertices, %zu tries: %zu given up on the coarse polygon, %zu refined; "
            "ends at %.6f\n", ne, given_up, refined, tk_run_latest(run)->ropelength);
     ck_assert_uint_gt(given_up, 0);
-    ck_assert_uint_gt(refined, 0);
     tk_run_free(&run);
     tk_curve_free(&c);
 }

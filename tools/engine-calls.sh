@@ -21,7 +21,7 @@ dir=$build/engine
 # (read-only questions on the run's state) and type.c (the knot type's
 # checks) serve every room from just above them.
 levels='
-0 curve geometry struts nnls rigidity invariants record error vect generate thickness
+0 curve geometry struts nnls rigidity invariants record error vect generate thickness relax
 1 queries type
 2 active
 3 motion

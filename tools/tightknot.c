@@ -3,7 +3,8 @@
  *   tightknot info [--json] [--tolerance EPS] FILE...
  *   tightknot struts [--json] [--tolerance EPS] FILE
  *   tightknot generate torus P Q | figure-eight | lissajous NX NY NZ | hopf | borromean | chain K
- *                      | deform FILE [SEED]
+ *                      | deform FILE [SEED] | relax FILE [STEPS]
+ *                      | turn FILE [SEED]
  *                      [--vertices N] [--disguise SEED]
  *   tightknot tighten FILE [run options] [-o OUT] [--struts OUT] [--log OUT]
  *                    [--snapshots DIR --every K] [--json]
@@ -32,6 +33,7 @@
 #include "tk/curve.h"
 #include "tk/error.h"
 #include "tk/generate.h"
+#include "tk/relax.h"
 #include "tk/invariants.h"
 #include "tk/record.h"
 #include "cli.h"
@@ -182,6 +184,19 @@ static const char generate_help[] =
     "              each component, drawn from SEED, default 1) that keeps\n"
     "              FILE's knot or link type and a twentieth of its\n"
     "              thickness ('-': standard input)\n"
+    "  relax FILE [STEPS]\n"
+    "              FILE's curve relaxed under a repulsive energy at its own\n"
+    "              length (every strand pushed from every other, bends\n"
+    "              smoothed out), for at most STEPS steps (default 2000):\n"
+    "              a shape of the same type that forgets the file's; its\n"
+    "              type is kept exactly (closed components only)\n"
+    "  turn FILE [SEED]\n"
+    "              FILE's curve turned inside out: inverted in a sphere about\n"
+    "              its centroid (SEED 0, the default) or a point near it\n"
+    "              (drawn from SEED), mirrored, and relaxed for 3000 steps;\n"
+    "              what wound around the centre then winds around the curve\n"
+    "              (a torus knot's T(p,q) form becomes its T(q,p) form), the\n"
+    "              type kept; --vertices N in all (default FILE's count)\n"
     "  chain K     K >= 1 rings of radius 1, centres 1.5 apart on the x axis,\n"
     "              in alternating planes, each linked with its neighbours\n"
     "\n"
@@ -240,9 +255,11 @@ static const char tighten_help_end[] =
     "                          link type of the input and of the result, as in\n"
     "                          'tightknot info --json', escapes: [{step,\n"
     "                          from, amplitude, coarse, reached, improved,\n"
-    "                          explored}], one per escape tried (explored: on\n"
-    "                          the coarsest polygon alone, before the first\n"
-    "                          refinement), basins: {basins: [{ropelength,\n"
+    "                          explored, turned}], one per escape tried\n"
+    "                          (explored: on the coarsest polygon alone,\n"
+    "                          before the first refinement; turned: the curve\n"
+    "                          turned inside out, as 'generate turn', not\n"
+    "                          deformed), basins: {basins: [{ropelength,\n"
     "                          times}], best_reached, note}, the distinct\n"
     "                          results its tightenings on the final polygon\n"
     "                          reached, lowest first, with how often (a\n"
@@ -697,6 +714,9 @@ static int cmd_struts(int argc, char **argv)
  * far tries do (engine/escape.c): loose enough that its tightening can
  * find another basin than the file's. */
 #define DEFORM_KEEP 0.05
+/* generate turn: relaxation steps after the turn, as the escapes'
+ * turned tries take (engine/escape.c) */
+#define TURN_STEPS 3000
 
 /* Builds the curve a generate command line asks for; EXIT_USAGE with a
  * message when the shape or its arguments are wrong. */
@@ -705,7 +725,7 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
     const char *cmd = "generate";
     if (npos == 0)
         return usage_error(cmd, "no SHAPE given (torus P Q, figure-eight, lissajous NX NY NZ, "
-                                "hopf, borromean, chain K or deform FILE)");
+                                "hopf, borromean, chain K, deform FILE, relax FILE or turn FILE)");
     const char *shape = pos[0];
     tk_error err;
     tk_error_clear(&err);
@@ -756,6 +776,42 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
             report(NULL, &err);
             return EXIT_INPUT;
         }
+    } else if (strcmp(shape, "relax") == 0) {
+        if (npos != 2 && npos != 3)
+            return usage_error(cmd, "relax takes a FILE and optionally a number of STEPS");
+        long long steps = 2000;
+        if (npos == 3 && parse_integer(cmd, "relax STEPS", pos[2], 1, INT_MAX, &steps))
+            return EXIT_USAGE;
+        tk_curve *src = NULL;
+        rc = tk_vect_read_file(input_path(pos[1]), NULL, &src, &err);
+        if (!rc)
+            rc = tk_relax(src, NULL, 0.0, (int)steps, out, NULL, &err);
+        tk_curve_free(&src);
+        if (rc == TK_EPARSE || rc == TK_EIO) {
+            report(NULL, &err);
+            return EXIT_INPUT;
+        }
+    } else if (strcmp(shape, "turn") == 0) {
+        if (npos != 2 && npos != 3)
+            return usage_error(cmd, "turn takes a FILE and optionally a SEED");
+        long long seed = 0;
+        if (npos == 3 && parse_integer(cmd, "turn SEED", pos[2], 0, 1LL << 53, &seed))
+            return EXIT_USAGE;
+        tk_curve *src = NULL;
+        rc = tk_vect_read_file(input_path(pos[1]), NULL, &src, &err);
+        if (!rc) {
+            double offset[3] = {0.0, 0.0, 0.0};
+            uint64_t state = (uint64_t)seed;
+            if (seed > 0)
+                tk_relax_turn_offset(&state, offset);
+            rc = tk_relax_turn(src, offset, vertices ? vertices : src->nvert, TURN_STEPS, out,
+                               &err);
+        }
+        tk_curve_free(&src);
+        if (rc == TK_EPARSE || rc == TK_EIO) {
+            report(NULL, &err);
+            return EXIT_INPUT;
+        }
     } else if (strcmp(shape, "chain") == 0) {
         if (npos != 2)
             return usage_error(cmd, "chain takes one argument, K");
@@ -766,7 +822,7 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
     } else {
         return usage_error(cmd,
                            "unknown shape '%s' (torus P Q, figure-eight, lissajous NX NY NZ, "
-                           "hopf, borromean, chain K or deform FILE)",
+                           "hopf, borromean, chain K, deform FILE, relax FILE or turn FILE)",
                            shape);
     }
     if (rc == TK_EINVAL || rc == TK_ELIMIT)
@@ -1027,8 +1083,11 @@ static int cmd_tighten(int argc, char **argv)
         size_t ne = 0;
         const tk_escape *e = tk_run_escapes(run, &ne);
         for (size_t k = 0; k < ne; k++) {
-            printf("  escape %zu after step %ld: from %.9g, deformed by %.3g diameters, ", k + 1,
-                   e[k].step, e[k].from, e[k].amplitude);
+            printf("  escape %zu after step %ld: from %.9g, ", k + 1, e[k].step, e[k].from);
+            if (e[k].turned)
+                printf("turned inside out, ");
+            else
+                printf("deformed by %.3g diameters, ", e[k].amplitude);
             if (e[k].explored) {
                 if (isnan(e[k].coarse))
                     printf("explored, stopped on the coarsest polygon\n");

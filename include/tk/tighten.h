@@ -120,8 +120,9 @@
     X(escapes, INT, 8, 0, 1000, "escapes",                                                   \
       "most escapes: each time the ropelength all but stops falling on the final polygon "   \
       "(or has crawled there for a fifth of the budget) before the last fifth of the "       \
-      "budget, the best curve so far is deformed at random (every second time loosened "     \
-      "many times over) and tightened again; the last fifth polishes the best curve; the "   \
+      "budget, the best curve so far is changed at random (in turn: deformed a little, "     \
+      "turned inside out about a point near its centre, deformed and loosened many times " \
+      "over) and tightened again; the last fifth polishes the best curve; the "              \
       "result is the best curve found; before that, in the first quarter of the budget, "    \
       "as many tries again explore the coarsest polygon alone, from the lowest curve found " \
       "there (0: none)")                                                                     \
@@ -254,6 +255,8 @@ typedef struct tk_escape {
     double reached;
     bool improved;      /* reached < from (explored: coarse < from) */
     bool explored;      /* on the coarsest polygon only */
+    bool turned;        /* the curve turned inside out (tk/relax.h), not
+                           deformed: amplitude 0 */
 } tk_escape;
 
 const tk_escape *tk_run_escapes(const tk_run *r, size_t *count);

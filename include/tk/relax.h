@@ -1,0 +1,81 @@
+/* tightknot: relaxing a curve under a repulsive energy, to a shape of its
+ * type that forgets the start's.
+ *
+ * The tightening flow is a gradient flow of ropelength: it ends in the
+ * basin its start lies in.  A start's shape (the projection it was drawn
+ * from, a crossing pushed to one side) can hold it in a basin above the
+ * knot's lowest.  A repulsive energy, minimised at fixed length, spreads
+ * every strand away from every other and smooths the curve out: the
+ * strands' arrangement is kept (the type cannot change, below) but the
+ * start's accidents are lost, and what remains is a shape of the type
+ * itself, often a symmetric one (a torus knot relaxes toward its torus
+ * form).  Its tightening explores another basin than the start's.
+ *
+ * The energy (of the vertices x_i, h the mean edge length):
+ *     E = sum over pairs of edges of h^2 / r^2
+ *       + w sum over edges e of a component of mean edge length h_c,
+ *             of (|e| - h_c)^2 / h^2,
+ * over pairs of edges that share no vertex, r their distance (not the
+ * vertices': an edge can pass between two vertices, not through an edge
+ * whose distance enters E), the first a discrete form of the
+ * Moebius-like energy 1 / |x - y|^2 (near pairs penalise bending, far
+ * ones closeness), the second springs that keep the vertices evenly
+ * spread (w = 20).  With a target curve y of as many vertices, a pull
+ *       + p sum over vertices of |x_i - y_i|^2 / h_y^2 (h_y the target's mean edge)
+ * draws the curve toward y while the repulsion keeps its strands apart:
+ * a deformation as large as the knot itself that is an isotopy, where a
+ * displacement applied at once keeps the type only while it is smaller
+ * than the gaps between strands.
+ */
+#ifndef TK_RELAX_H
+#define TK_RELAX_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "tk/curve.h"
+#include "tk/error.h"
+
+/* E above (with the pull when target is not NULL), and its gradient into
+ * grad (3 per vertex) when not NULL. */
+double tk_relax_energy(const tk_curve *c, const tk_curve *target, double pull, double *grad);
+
+/* The least distance between two edges that share no vertex (+inf when
+ * there are none). */
+double tk_relax_gap(const tk_curve *c);
+
+/* Relaxes a copy of c into *out (toward target with the given pull when
+ * target is not NULL: as many vertices, pull >= 0) by up to `iterations`
+ * steps of gradient descent on E, each rescaled about the centroid to c's length.  No
+ * vertex moves by more than a quarter of the gap (tk_relax_gap) in one
+ * step, so along the straight path between two steps every point of an
+ * edge moves by less than half of it and no two edges that share no
+ * vertex meet: the knot or link type is kept exactly.  Stops early when E
+ * falls by less than 1e-9 (relative) in 50 steps.  Closed components
+ * only (TK_EINVAL otherwise); *steps (when not NULL) gets the steps
+ * taken. */
+int tk_relax(const tk_curve *c, const tk_curve *target, double pull, int iterations,
+             tk_curve **out, int *steps, tk_error *err);
+
+/* The curve turned inside out: inverted in the unit sphere about a centre
+ * (x -> (x - c) / |x - c|^2) and mirrored, scaled back to its length,
+ * resampled to `vertices` and relaxed for `steps` (tk_relax).  Strands
+ * near the centre go far out and far ones come in: what the curve wound
+ * around it now winds around the curve (a torus knot's T(p, q) form
+ * becomes its T(q, p) form), a shape of the same type far from the
+ * start's that no small deformation reaches.  The centre is the curve's
+ * centroid as a wire plus `offset` times its spread (the root mean
+ * square distance of its points from the centroid).  Inversion and
+ * mirror keep the type and its chirality on the smooth curve; the result
+ * is checked (Alexander polynomials and linking numbers) all the same.
+ * TK_ENUMERIC when the centre lies within 1e-3 of the spread from the
+ * curve, or the polygon's type changed (too few vertices). */
+int tk_relax_turn(const tk_curve *c, const double offset[3], size_t vertices, int steps,
+                  tk_curve **out, tk_error *err);
+
+/* A centre's offset for tk_relax_turn drawn from the stream *state:
+ * normal coordinates of standard deviation 0.15 (of the spread): a point
+ * near the centroid, where the curve winds around. */
+void tk_relax_turn_offset(uint64_t *state, double offset[3]);
+
+#endif

@@ -1,0 +1,282 @@
+/* Unit tests of the repulsive relaxation (engine/relax.c): the energy's
+ * gradient against central finite differences, with and without a pull;
+ * the gap against a brute force of its own; a relaxation keeps the type
+ * (Alexander polynomial and linking numbers computed again), the length,
+ * and every edge apart; a round circle, a critical point of E by its
+ * symmetry, stays; turned inside out, a curve keeps its type and hand;
+ * argument errors. */
+#include <check.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "support.h"
+#include "tk/curve.h"
+#include "tk/generate.h"
+#include "tk/invariants.h"
+#include "tk/relax.h"
+
+/* A two-component link, disguised: uneven edges and no symmetry, so that
+ * every term of the gradient (springs of two lengths, the pull) counts. */
+static tk_curve *uneven_link(void)
+{
+    tk_curve *plain = NULL, *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 4, 30, &plain, NULL), TK_OK);
+    ck_assert_int_eq(tk_generate_disguise(plain, 3, 0.05, &c, NULL), TK_OK);
+    tk_curve_free(&plain);
+    return c;
+}
+
+static void check_gradient(const tk_curve *target, double pull)
+{
+    tk_curve *c = uneven_link();
+    double *grad = malloc(3 * c->nvert * sizeof *grad);
+    tk_relax_energy(c, target, pull, grad);
+    double worst = 0.0;
+    for (size_t k = 0; k < 3 * c->nvert; k += 7) {
+        double x = c->xyz[k], step = 1e-6;
+        c->xyz[k] = x + step;
+        double up = tk_relax_energy(c, target, pull, NULL);
+        c->xyz[k] = x - step;
+        double down = tk_relax_energy(c, target, pull, NULL);
+        c->xyz[k] = x;
+        double fd = (up - down) / (2.0 * step);
+        worst = fmax(worst, fabs(fd - grad[k]) / fmax(1.0, fabs(fd)));
+    }
+    ck_assert_msg(worst < 1e-6, "gradient against finite differences: worst %g", worst);
+    free(grad);
+    tk_curve_free(&c);
+}
+
+START_TEST(energy_gradient_matches_finite_differences)
+{
+    check_gradient(NULL, 0.0);
+    tk_curve *target = uneven_link();
+    tk_curve_scale(target, 1.7);
+    check_gradient(target, 0.8);
+    tk_curve_free(&target);
+}
+END_TEST
+
+/* The gap: the least distance between edges that share no vertex,
+ * against the minimum over sampled points of each edge pair (an upper
+ * bound that comes within the sampling's resolution). */
+START_TEST(gap_against_sampled_points)
+{
+    tk_curve *c = uneven_link();
+    double gap = tk_relax_gap(c), sampled = INFINITY;
+    size_t m = tk_curve_edge_count(c);
+    for (size_t i = 0; i < m; i++) {
+        tk_edge a = tk_curve_edge(c, i);
+        for (size_t j = i + 1; j < m; j++) {
+            tk_edge b = tk_curve_edge(c, j);
+            if (a.head == b.head || a.head == b.tail || a.tail == b.head || a.tail == b.tail)
+                continue;
+            const double *a0 = tk_curve_vertex(c, a.head), *a1 = tk_curve_vertex(c, a.tail);
+            const double *b0 = tk_curve_vertex(c, b.head), *b1 = tk_curve_vertex(c, b.tail);
+            for (int s = 0; s <= 40; s++) {
+                double p[3];
+                for (int k = 0; k < 3; k++)
+                    p[k] = a0[k] + (a1[k] - a0[k]) * s / 40.0;
+                sampled = fmin(sampled, tkt_point_segment(p, b0, b1));
+            }
+        }
+    }
+    ck_assert(gap <= sampled + 1e-12);
+    ck_assert_msg(sampled - gap < 0.02 * gap, "gap %g, sampled %g", gap, sampled);
+    tk_curve_free(&c);
+}
+END_TEST
+
+static void check_kept(const tk_curve *before, const tk_curve *after)
+{
+    tk_invariants was = TK_INVARIANTS_INIT, now = TK_INVARIANTS_INIT;
+    ck_assert_int_eq(tk_invariants_compute(before, &was, NULL), TK_OK);
+    ck_assert_int_eq(tk_invariants_compute(after, &now, NULL), TK_OK);
+    ck_assert_int_eq(tk_invariants_compare(&was, &now, NULL), TK_OK);
+    ck_assert(tk_relax_gap(after) > 0.0);
+    tk_invariants_free(&was);
+    tk_invariants_free(&now);
+}
+
+/* Relaxed, a disguised trefoil and a disguised link keep their types and
+ * lengths, their energy falls, and they move: the far strands spread. */
+START_TEST(relaxation_keeps_type_and_length)
+{
+    tk_curve *plain = NULL, *knot = NULL, *link = uneven_link();
+    ck_assert_int_eq(tk_generate_torus(2, 3, 60, &plain, NULL), TK_OK);
+    ck_assert_int_eq(tk_generate_disguise(plain, 5, 0.05, &knot, NULL), TK_OK);
+    tk_curve *starts[2] = {knot, link};
+    for (int s = 0; s < 2; s++) {
+        tk_curve *out = NULL;
+        int steps = 0;
+        ck_assert_int_eq(tk_relax(starts[s], NULL, 0.0, 400, &out, &steps, NULL), TK_OK);
+        ck_assert(steps > 100);
+        ck_assert(tk_relax_energy(out, NULL, 0.0, NULL) <
+                  0.9 * tk_relax_energy(starts[s], NULL, 0.0, NULL));
+        ck_assert_double_eq_tol(tk_curve_length(out), tk_curve_length(starts[s]),
+                                1e-12 * tk_curve_length(starts[s]));
+        check_kept(starts[s], out);
+        tk_curve_free(&out);
+    }
+    tk_curve_free(&plain);
+    tk_curve_free(&knot);
+    tk_curve_free(&link);
+}
+END_TEST
+
+/* Pulled toward a far target that passes through itself (the trefoil's
+ * vertices sent around a circle: the unknot's shape), the trefoil goes as
+ * far as its strands let it and stays a trefoil. */
+START_TEST(a_pull_cannot_change_the_type)
+{
+    tk_curve *knot = NULL, *circle = NULL, *out = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 60, &knot, NULL), TK_OK);
+    ck_assert_int_eq(tk_curve_copy(knot, &circle, NULL), TK_OK);
+    for (size_t v = 0; v < circle->nvert; v++) {
+        double t = 2.0 * M_PI * (double)v / (double)circle->nvert, *p = tk_curve_vertex(circle, v);
+        p[0] = 3.0 * cos(t);
+        p[1] = 3.0 * sin(t);
+        p[2] = 0.0;
+    }
+    int steps = 0;
+    ck_assert_int_eq(tk_relax(knot, circle, 1.0, 1500, &out, &steps, NULL), TK_OK);
+    ck_assert(steps > 100);
+    double before = 0.0, after = 0.0;
+    for (size_t v = 0; v < knot->nvert; v++)
+        for (int k = 0; k < 3; k++) {
+            before += pow(knot->xyz[3 * v + k] - circle->xyz[3 * v + k], 2);
+            after += pow(out->xyz[3 * v + k] - circle->xyz[3 * v + k], 2);
+        }
+    ck_assert(after < 0.5 * before);
+    check_kept(knot, out);
+    tk_curve_free(&knot);
+    tk_curve_free(&circle);
+    tk_curve_free(&out);
+}
+END_TEST
+
+/* A regular polygon is critical for E (every vertex alike): it stays. */
+START_TEST(a_round_circle_stays)
+{
+    tk_curve *c = tkt_regular_polygon(40, 2.0), *out = NULL;
+    ck_assert_int_eq(tk_relax(c, NULL, 0.0, 100, &out, NULL, NULL), TK_OK);
+    double moved = 0.0;
+    for (size_t k = 0; k < 3 * c->nvert; k++)
+        moved = fmax(moved, fabs(out->xyz[k] - c->xyz[k]));
+    ck_assert_msg(moved < 1e-9, "moved %g", moved);
+    tk_curve_free(&c);
+    tk_curve_free(&out);
+}
+END_TEST
+
+/* The writhe by the Gauss double integral over edge midpoints (an
+ * independent figure: its sign is the trefoil's handedness). */
+static double writhe(const tk_curve *c)
+{
+    size_t m = tk_curve_edge_count(c);
+    double w = 0.0;
+    for (size_t i = 0; i < m; i++)
+        for (size_t j = 0; j < m; j++) {
+            if (i == j)
+                continue;
+            tk_edge a = tk_curve_edge(c, i), b = tk_curve_edge(c, j);
+            const double *a0 = tk_curve_vertex(c, a.head), *a1 = tk_curve_vertex(c, a.tail);
+            const double *b0 = tk_curve_vertex(c, b.head), *b1 = tk_curve_vertex(c, b.tail);
+            double ta[3], tb[3], d[3];
+            for (int k = 0; k < 3; k++) {
+                ta[k] = a1[k] - a0[k];
+                tb[k] = b1[k] - b0[k];
+                d[k] = 0.5 * (a0[k] + a1[k]) - 0.5 * (b0[k] + b1[k]);
+            }
+            double cx[3] = {ta[1] * tb[2] - ta[2] * tb[1], ta[2] * tb[0] - ta[0] * tb[2],
+                            ta[0] * tb[1] - ta[1] * tb[0]};
+            double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            w += (cx[0] * d[0] + cx[1] * d[1] + cx[2] * d[2]) / (r * r * r);
+        }
+    return w / (4.0 * M_PI);
+}
+
+/* Turned inside out, a trefoil stays a trefoil of the same hand (its
+ * writhe keeps its sign: the mirror undoes the inversion's), a link keeps
+ * its linking number.  A centre on the curve is refused, not followed
+ * (its image would be at infinity). */
+START_TEST(turning_keeps_type_and_hand)
+{
+    tk_curve *knot = NULL, *link = NULL, *out = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 120, &knot, NULL), TK_OK);
+    double zero[3] = {0.0, 0.0, 0.0};
+    ck_assert_int_eq(tk_relax_turn(knot, zero, 90, 500, &out, NULL), TK_OK);
+    ck_assert_uint_eq(out->nvert, 90);
+    check_kept(knot, out);
+    double before = writhe(knot), after = writhe(out);
+    printf("writhe %.4f turned %.4f\n", before, after);
+    ck_assert(fabs(before) > 2.0 && before * after > 0.0);
+    tk_curve_free(&out);
+    ck_assert_int_eq(tk_generate_torus(2, 4, 60, &link, NULL), TK_OK);
+    uint64_t state = 3;
+    double offset[3];
+    tk_relax_turn_offset(&state, offset);
+    ck_assert_int_eq(tk_relax_turn(link, offset, 80, 300, &out, NULL), TK_OK);
+    check_kept(link, out);
+    tk_curve_free(&out);
+    /* the torus generator's curve passes at distance 1 around the axis:
+     * an offset of the spread that lands on the curve is refused */
+    tk_curve_free(&knot);
+    ck_assert_int_eq(tk_generate_torus(2, 5, 200, &knot, NULL), TK_OK);
+    const double *v = tk_curve_vertex(knot, 0);
+    double centre[3] = {0.0, 0.0, 0.0}, spread = 0.0;
+    for (size_t i = 0; i < knot->nvert; i++)
+        for (int k = 0; k < 3; k++)
+            centre[k] += knot->xyz[3 * i + k] / (double)knot->nvert;
+    for (size_t i = 0; i < knot->nvert; i++)
+        for (int k = 0; k < 3; k++)
+            spread += pow(knot->xyz[3 * i + k] - centre[k], 2) / (double)knot->nvert;
+    spread = sqrt(spread);
+    double onto[3];
+    for (int k = 0; k < 3; k++)
+        onto[k] = (v[k] - centre[k]) / spread;
+    tk_error err;
+    ck_assert_int_eq(tk_relax_turn(knot, onto, 80, 10, &out, &err), TK_ENUMERIC);
+    printf("%s\n", err.message);
+    ck_assert(strstr(err.message, "too near") || strstr(err.message, "changed its type"));
+    ck_assert_ptr_null(out);
+    tk_curve_free(&knot);
+    tk_curve_free(&link);
+}
+END_TEST
+
+START_TEST(invalid_arguments)
+{
+    tk_curve *c = tkt_regular_polygon(12, 1.0), *other = tkt_regular_polygon(13, 1.0);
+    tk_curve *out = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_relax(c, other, 1.0, 10, &out, NULL, &err), TK_EINVAL);
+    ck_assert_ptr_nonnull(strstr(err.message, "12 vertices"));
+    ck_assert_int_eq(tk_relax(c, c, -1.0, 10, &out, NULL, &err), TK_EINVAL);
+    c->closed[0] = false;
+    ck_assert_int_eq(tk_relax(c, NULL, 0.0, 10, &out, NULL, &err), TK_EINVAL);
+    ck_assert_ptr_nonnull(strstr(err.message, "open"));
+    ck_assert_ptr_null(out);
+    tk_curve_free(&c);
+    tk_curve_free(&other);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("relax");
+    TCase *tc = tcase_create("relax");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, energy_gradient_matches_finite_differences);
+    tcase_add_test(tc, gap_against_sampled_points);
+    tcase_add_test(tc, relaxation_keeps_type_and_length);
+    tcase_add_test(tc, a_pull_cannot_change_the_type);
+    tcase_add_test(tc, a_round_circle_stays);
+    tcase_add_test(tc, turning_keeps_type_and_hand);
+    tcase_add_test(tc, invalid_arguments);
+    suite_add_tcase(s, tc);
+    return tkt_run_suite(s);
+}
