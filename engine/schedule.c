@@ -577,7 +577,16 @@ static void keep_at_tube(tk_run *r)
     if (!r->opt.autoscale || s->vertices != r->shared.curve->nvert ||
         !(s->thickness > r->opt.autoscale_margin * r->tau))
         return;
-    tk_curve_scale(r->shared.curve, r->opt.autoscale_margin * r->tau / s->thickness);
+    /* the first step after a restart reports the figures of the curve it
+     * was given: catalogue 10.124 turned inside out reported 1.045 where
+     * its curve was at 0.999999, was scaled 4% below the tube, and its
+     * run failed; the thinner of the two is the one to scale by */
+    double thickness = s->thickness;
+    tk_measure now;
+    if (measure(r->shared.curve, &now, NULL) == TK_OK && now.thickness < thickness)
+        thickness = now.thickness;
+    if (thickness > r->opt.autoscale_margin * r->tau)
+        tk_curve_scale(r->shared.curve, r->opt.autoscale_margin * r->tau / thickness);
 }
 
 /* With the vertices option a start too loose for a coarse level (fewer
