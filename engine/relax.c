@@ -22,11 +22,13 @@
 #define RELAX_GROW 1.5
 #define RELAX_MOVE 0.25
 /* Turning inside out: the curve is first resampled to at least TURN_FINE
- * vertices (8 for each of the result's), and the centre must be at least
- * TURN_CLEARANCE of the curve's spread from it. */
+ * vertices (32 for each of the result's), and the centre must be at
+ * least TURN_CLEARANCE of the curve's spread from it; the result's count
+ * doubles up to TURN_DOUBLINGS - 1 times until its type is the curve's. */
 #define TURN_FINE 1000
 #define TURN_CLEARANCE 1e-3
 #define TURN_OFFSET 0.15
+#define TURN_DOUBLINGS 3
 
 double tk_relax_energy(const tk_curve *c, const tk_curve *target, double pull, double *grad)
 {
@@ -221,8 +223,8 @@ int tk_relax_turn(const tk_curve *c, const double offset[3], size_t vertices, in
         return rc;
     /* edges short against the centre's distance: the image of a straight
      * edge is an arc, and the polygon through the images' vertices must
-     * stay of the type (checked below all the same) */
-    size_t fine = TURN_FINE > 8 * vertices ? TURN_FINE : 8 * vertices;
+     * stay of the type (checked below) */
+    size_t fine = TURN_FINE > 32 * vertices ? TURN_FINE : 32 * vertices;
     tk_curve *x = NULL, *coarse = NULL;
     tk_invariants type = TK_INVARIANTS_INIT, now = TK_INVARIANTS_INIT;
     rc = tk_curve_resample_total(c, fine, &x, err);
@@ -262,17 +264,26 @@ int tk_relax_turn(const tk_curve *c, const double offset[3], size_t vertices, in
     }
     if (!rc) {
         tk_curve_scale(x, length / tk_curve_length(x));
-        rc = tk_curve_resample_total(x, vertices, &coarse, err);
-    }
-    if (!rc)
-        rc = tk_relax(coarse, NULL, 0.0, steps, out, NULL, err);
-    if (!rc)
         rc = tk_invariants_compute(c, &type, err);
-    if (!rc)
-        rc = tk_invariants_compute(*out, &now, err);
-    if (!rc && tk_invariants_compare(&type, &now, NULL) != TK_OK)
-        rc = tk_error_set(err, TK_ENUMERIC, "turned inside out on %zu vertices, the curve "
-                          "changed its type: too few vertices for it", vertices);
+    }
+    /* the inverted curve is uneven (what was near the centre is now far
+     * out and long): on too few vertices its polygon can pass through
+     * itself, so the count doubles until the type is kept */
+    bool kept = false;
+    for (int tries = 0; !rc && !kept && tries < TURN_DOUBLINGS; tries++, vertices *= 2) {
+        tk_curve_free(&coarse);
+        tk_curve_free(out);
+        tk_invariants_free(&now);
+        rc = tk_curve_resample_total(x, vertices, &coarse, err);
+        if (!rc)
+            rc = tk_invariants_compute(coarse, &now, err);
+        kept = !rc && tk_invariants_compare(&type, &now, NULL) == TK_OK;
+    }
+    if (!rc && kept)
+        rc = tk_relax(coarse, NULL, 0.0, steps, out, NULL, err);
+    if (!rc && !kept)
+        rc = tk_error_set(err, TK_ENUMERIC, "turned inside out on up to %zu vertices, the "
+                          "curve changed its type", vertices / 2);
     if (rc)
         tk_curve_free(out);
     tk_invariants_free(&type);

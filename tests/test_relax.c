@@ -222,8 +222,10 @@ START_TEST(turning_keeps_type_and_hand)
     ck_assert_int_eq(tk_relax_turn(link, offset, 80, 300, &out, NULL), TK_OK);
     check_kept(link, out);
     tk_curve_free(&out);
-    /* the torus generator's curve passes at distance 1 around the axis:
-     * an offset of the spread that lands on the curve is refused */
+    /* centres along the ray from the centroid through a vertex: each
+     * turns the curve keeping its type or is refused, and those within
+     * 1e-3 of the spread from the curve are refused as too near (the
+     * spread and centroid here are the vertices', near the wire's) */
     tk_curve_free(&knot);
     ck_assert_int_eq(tk_generate_torus(2, 5, 200, &knot, NULL), TK_OK);
     const double *v = tk_curve_vertex(knot, 0);
@@ -235,14 +237,26 @@ START_TEST(turning_keeps_type_and_hand)
         for (int k = 0; k < 3; k++)
             spread += pow(knot->xyz[3 * i + k] - centre[k], 2) / (double)knot->nvert;
     spread = sqrt(spread);
-    double onto[3];
-    for (int k = 0; k < 3; k++)
-        onto[k] = (v[k] - centre[k]) / spread;
-    tk_error err;
-    ck_assert_int_eq(tk_relax_turn(knot, onto, 80, 10, &out, &err), TK_ENUMERIC);
-    printf("%s\n", err.message);
-    ck_assert(strstr(err.message, "too near") || strstr(err.message, "changed its type"));
-    ck_assert_ptr_null(out);
+    int near = 0, turned = 0;
+    for (int step = -20; step <= 20; step++) {
+        double onto[3];
+        for (int k = 0; k < 3; k++)
+            onto[k] = (1.0 + 0.0025 * step) * (v[k] - centre[k]) / spread;
+        tk_error err;
+        int rc = tk_relax_turn(knot, onto, 80, 5, &out, &err);
+        if (rc == TK_OK) {
+            check_kept(knot, out);
+            turned++;
+        } else {
+            ck_assert_int_eq(rc, TK_ENUMERIC);
+            ck_assert_ptr_null(out);
+            near += strstr(err.message, "too near") != NULL;
+        }
+        tk_curve_free(&out);
+    }
+    printf("centres along the ray: %d turned, %d too near\n", turned, near);
+    ck_assert_int_gt(near, 0);
+    ck_assert_int_gt(turned, 0);
     tk_curve_free(&knot);
     tk_curve_free(&link);
 }

@@ -66,10 +66,12 @@ int tk_relax(const tk_curve *c, const tk_curve *target, double pull, int iterati
  * start's that no small deformation reaches.  The centre is the curve's
  * centroid as a wire plus `offset` times its spread (the root mean
  * square distance of its points from the centroid).  Inversion and
- * mirror keep the type and its chirality on the smooth curve; the result
- * is checked (Alexander polynomials and linking numbers) all the same.
- * TK_ENUMERIC when the centre lies within 1e-3 of the spread from the
- * curve, or the polygon's type changed (too few vertices). */
+ * mirror keep the type and its chirality on the smooth curve; the
+ * polygon's is checked (Alexander polynomials and linking numbers), and
+ * where too few vertices let it pass through itself their count doubles
+ * (twice at most; the result can have 4 x `vertices`).  TK_ENUMERIC when
+ * the centre lies within 1e-3 of the spread from the curve, or the type
+ * changed all the same. */
 int tk_relax_turn(const tk_curve *c, const double offset[3], size_t vertices, int steps,
                   tk_curve **out, tk_error *err);
 
