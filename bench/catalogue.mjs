@@ -14,9 +14,10 @@
 // the table of every knot done so far, over every slice run into OUT, is
 // written to TABLE: its type, the ropelength of each start, the lowest,
 // the spread between starts, the struts and kinks and seconds of the
-// lowest, the settings.  Then a summary: how many knots have every start
-// within 0.1% of their lowest, the widest spreads, how often the
-// catalogue's own start was the one trapped, and by how much.
+// lowest, the starts whose result's type (measured again with `tightknot
+// info`) is not the file's, the settings.  Then a summary: how many knots
+// have every start within 0.1% of their lowest, the widest spreads, how
+// often the catalogue's own start was the one trapped, and by how much.
 //
 // It resumes: run again, it submits only the starts without a result
 // (the client's own resume); its daemon's store keeps the jobs of a run
@@ -257,8 +258,8 @@ function writeTable() {
     }
     const settings = `resolution ${opt.resolution}, ${opt.seconds} s a start, autoscale, default escapes`;
     const lines = [['name', 'components', 'type', 'vertices', 'starts', 'lowest', 'lowest.start',
-        'spread.%', 'cat.above.%', 'struts', 'kinks', 'seconds', 'failed', 'settings'].join('\t')];
-    const summary = { knots: 0, compared: 0, agree: 0, spreads: [], catTrapped: [], failed: [] };
+        'spread.%', 'cat.above.%', 'struts', 'kinks', 'seconds', 'failed', 'type.changed', 'settings'].join('\t')];
+    const summary = { knots: 0, compared: 0, agree: 0, spreads: [], catTrapped: [], failed: [], changed: [] };
     for (const knot of [...byKnot.keys()].sort(natural)) {
         const starts = byKnot.get(knot).sort((a, b) => natural(a.tag, b.tag));
         const ok = starts.filter((s) => s.state === 'done' && Number.isFinite(s.ropelength));
@@ -270,15 +271,26 @@ function writeTable() {
         const spread = 100 * (worst.ropelength - best.ropelength) / best.ropelength;
         const cat = ok.find((s) => s.tag === 'cat');
         const catAbove = cat ? 100 * (cat.ropelength - best.ropelength) / best.ropelength : NaN;
-        let type = '';
+        let type = '', want = null;
         try {
-            type = typeText(JSON.parse(readFileSync(join(startsDir, `${knot}.type.json`), 'utf8')));
+            want = JSON.parse(readFileSync(join(startsDir, `${knot}.type.json`), 'utf8'));
+            type = typeText(want);
         } catch { /* made by another out directory */ }
+        // the type at the end, measured again on each result's curve
+        const changed = want ? ok.filter((s) => {
+            try {
+                return typeKey(info(join(s.dir, `${knot}@${s.tag}.vect`)).invariants) !== typeKey(want);
+            } catch {
+                return true;
+            }
+        }).map((s) => s.tag) : [];
+        for (const tag of changed) summary.changed.push(`${knot}@${tag}`);
         lines.push([knot, best.components, type, best.vertices,
             ok.map((s) => `${s.tag}=${s.ropelength.toFixed(6)}`).join(' '), best.ropelength.toFixed(6),
             best.tag, spread.toFixed(4), Number.isFinite(catAbove) ? catAbove.toFixed(4) : '',
             best.struts, kinksOf(`${knot}@${best.tag}`, best.dir),
-            ok.reduce((t, s) => t + s.seconds, 0).toFixed(0), failed.length, settings].join('\t'));
+            ok.reduce((t, s) => t + s.seconds, 0).toFixed(0), failed.length,
+            want ? changed.join(' ') || 'none' : '', settings].join('\t'));
         summary.knots++;
         if (ok.length > 1) summary.compared++;
         if (ok.length > 1 && spread <= 0.1) summary.agree++;
@@ -299,6 +311,8 @@ function writeTable() {
     for (const [spread, knot, lo, lov, hi, hiv] of widest)
         console.log(`  ${knot}: ${spread.toFixed(3)}% apart (${lo} ${lov.toFixed(4)}, ${hi} ${hiv.toFixed(4)})`);
     for (const f of summary.failed) console.log(`  failed: ${f}`);
+    console.log(`  type at the end: ${summary.changed.length ? `changed in ${summary.changed.join(', ')}`
+        : 'the file\'s in every result'}`);
 }
 
 // ---- the run
