@@ -12,6 +12,7 @@
 
 #include "api.h"
 #include "cli.h"
+#include "tk/version.h"
 
 /* The daemon's numbers, each with its domain and default. */
 typedef struct settings {
@@ -61,7 +62,7 @@ int main(int argc, char **argv)
     const char *db = "var/tightknot.db", *priority = "idle", *tokens_file = NULL;
     settings set = {.api = {.bind = "127.0.0.1"}, .pool = {.flush_seconds = 2.0, .history = 2000}};
     tk_cli_defaults(fields, sizeof fields / sizeof fields[0], &set);
-    bool help = false, anonymous = false;
+    bool help = false, anonymous = false, version = false;
     tk_cli cli = {.n = 0};
     tk_cli_text(&cli, "bind", 0, "ADDR", &set.api.bind, "IPv4 address to listen on (default "
                 "127.0.0.1)");
@@ -93,11 +94,14 @@ int main(int argc, char **argv)
                 "loopback without --tokens (anyone who reaches it may submit and cancel)");
     tk_cli_fields(&cli, fields, sizeof fields / sizeof fields[0], &set);
     tk_cli_flag(&cli, "help", 'h', &help, "this text");
+    tk_cli_flag(&cli, "version", 0, &version, "print the release and stop");
     tk_error err;
     int npos = 0;
     if (tk_cli_parse(&cli, argc - 1, argv + 1, &npos, &err))
         return fprintf(stderr, "tightknotd: %s\n(tightknotd --help lists the options)\n",
                        err.message), 1;
+    if (version)
+        return printf("tightknotd %s\n", TK_VERSION) < 0;
     if (help) {
         printf("usage: tightknotd [options]\n\n"
                "The tightknot service: tightens knots and links given as Geomview VECT\n"

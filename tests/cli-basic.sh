@@ -121,6 +121,17 @@ done
 expect_status 0 "help info" "$tk" help info
 expect_match "^usage: tightknot info" "$tmp/out" "help info shows info's help"
 
+# --version: both programs print the release of include/tk/version.h
+release=$(sed -n -E 's/^#define TK_VERSION "([^"]*)"$/\1/p' include/tk/version.h)
+for prog in tightknot tightknotd; do
+    expect_status 0 "$prog --version" "$build/$prog" --version
+    if [ -n "$release" ] && [ "$(cat "$tmp/out")" = "$prog $release" ]; then
+        pass
+    else
+        fail "$prog --version printed '$(cat "$tmp/out")', want '$prog $release'"
+    fi
+done
+
 # ---------------------------------------------------------- usage errors
 
 "$tk" generate hopf >"$tmp/hopf.vect"

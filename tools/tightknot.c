@@ -34,6 +34,7 @@
 #include "tk/error.h"
 #include "tk/generate.h"
 #include "tk/relax.h"
+#include "tk/version.h"
 #include "tk/invariants.h"
 #include "tk/record.h"
 #include "cli.h"
@@ -70,6 +71,7 @@ static const char main_help[] =
     "\n"
     "Options:\n"
     "  -h, --help   show this help; 'tightknot COMMAND --help' shows a command's\n"
+    "  --version    the release\n"
     "\n"
     "Conventions: the thickness is the diameter of the thickest embedded tube\n"
     "(min of 2 * minrad and the shortest doubly critical self-distance);\n"
@@ -1181,6 +1183,8 @@ int main(int argc, char **argv)
     const char *name = argv[1];
     if (strcmp(name, "-h") == 0 || strcmp(name, "--help") == 0)
         return finish(cmd_help(0, NULL));
+    if (strcmp(name, "--version") == 0)
+        return finish(printf("tightknot %s\n", TK_VERSION) < 0 ? EXIT_FAILURE : EXIT_OK);
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (strcmp(name, commands[i].name) == 0)
             return finish(commands[i].run(argc - 2, argv + 2));
