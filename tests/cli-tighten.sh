@@ -226,5 +226,29 @@ cp "$tmp/trefoil.vect" "$tmp/in.vect"
     >/dev/null 2>"$tmp/err" && "$tk" info "$tmp/in.vect" >/dev/null
 check $? "tighten IN -o IN: in place: $(cat "$tmp/err")"
 
+# "-" as -o or --struts: the file on standard output, byte for byte what
+# a named file gets, and the report (text or --json) on standard error
+"$tk" tighten "$tmp/trefoil.vect" --autoscale --steps 40 -o "$tmp/named.vect" \
+    --struts "$tmp/named.json" >/dev/null 2>&1
+"$tk" tighten "$tmp/trefoil.vect" --autoscale --steps 40 -o - >"$tmp/piped.vect" \
+    2>"$tmp/report.txt"
+check $? "tighten -o - exits 0: $(head -c 200 "$tmp/report.txt")"
+cmp -s "$tmp/named.vect" "$tmp/piped.vect"
+check $? "-o - writes the VECT a named file gets"
+grep -q "40 steps" "$tmp/report.txt"
+check $? "-o -: the report goes to standard error: $(head -c 200 "$tmp/report.txt")"
+"$tk" tighten "$tmp/trefoil.vect" --autoscale --steps 40 --struts - --json \
+    >"$tmp/piped.json" 2>"$tmp/report.json"
+cmp -s "$tmp/named.json" "$tmp/piped.json"
+check $? "--struts - writes the struts file a named file gets"
+[ "$(value steps "$tmp/report.json")" = 40 ]
+check $? "--struts - --json: the JSON report goes to standard error"
+"$tk" tighten "$tmp/trefoil.vect" -o - --struts - >/dev/null 2>"$tmp/err"
+[ $? -eq 1 ] && grep -q "name one file" "$tmp/err"
+check $? "-o - and --struts - together: usage error: $(cat "$tmp/err")"
+"$tk" tighten "$tmp/trefoil.vect" --log - >/dev/null 2>"$tmp/err"
+[ $? -eq 1 ] && grep -q "name a file" "$tmp/err"
+check $? "--log -: usage error: $(cat "$tmp/err")"
+
 echo "cli-tighten: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -245,6 +245,8 @@ static const char tighten_help_end[] =
     "Outputs:\n"
     "  -o, --output OUT.vect   the tightened curve (VECT)\n"
     "  --struts OUT.json       the final struts and kinks with their forces\n"
+    "                          ('-' for either: standard output, and the\n"
+    "                          report then goes to standard error)\n"
     "  --log OUT.tsv           one line of figures per step\n"
     "  --snapshots DIR         write DIR/step-NNNNNN.vect every K steps\n"
     "  --every K               snapshot interval (default 100)\n"
@@ -450,8 +452,13 @@ static int check_outputs(const char *input, const char *const out[3])
     for (int i = 0; i < 3; i++) {
         if (!out[i])
             continue;
+        if (i == 2 && !strcmp(out[i], "-"))
+            return usage_error("tighten", "--log - : the log is written while the run goes and "
+                               "cannot share standard output with its report; name a file");
         for (int j = 0; j < i; j++)
-            if (out[j] && same_file(out[i], out[j]))
+            if (out[j] && (!strcmp(out[i], "-") || !strcmp(out[j], "-")
+                               ? !strcmp(out[i], out[j])
+                               : same_file(out[i], out[j])))
                 return usage_error("tighten", "%s and %s name one file (%s): each output needs "
                                    "its own", flag[j], flag[i], out[i]);
         if (i > 0 && strcmp(input, "-") && same_file(out[i], input))
@@ -880,9 +887,33 @@ typedef struct tighten_watch {
     int failed;          /* an output could not be written */
 } tighten_watch;
 
+/* "-" as an output path: standard output (the report that follows it then
+ * goes to standard error, to_stderr_after). */
+static FILE *open_output(const char *path)
+{
+    return strcmp(path, "-") ? fopen(path, "w") : stdout;
+}
+
+static int close_output(FILE *f)
+{
+    return f == stdout ? fflush(f) : fclose(f);
+}
+
+/* After an output written to standard output, the rest of what would go
+ * there goes to standard error. */
+static void to_stderr_after(const char *const out[3])
+{
+    for (int i = 0; i < 2; i++)
+        if (out[i] && !strcmp(out[i], "-")) {
+            fflush(stdout);
+            dup2(STDERR_FILENO, STDOUT_FILENO);
+            return;
+        }
+}
+
 static int write_vect_file(const char *path, const tk_curve *c)
 {
-    FILE *f = fopen(path, "w");
+    FILE *f = open_output(path);
     if (!f) {
         fprintf(stderr, "tightknot: cannot write %s: %s\n", path, strerror(errno));
         return EXIT_INPUT;
@@ -890,7 +921,7 @@ static int write_vect_file(const char *path, const tk_curve *c)
     tk_error err;
     tk_error_clear(&err);
     int rc = tk_vect_write(c, f, &err);
-    if (fclose(f) != 0 && rc == TK_OK)
+    if (close_output(f) != 0 && rc == TK_OK)
         rc = tk_error_set(&err, TK_EIO, "closing failed: %s", strerror(errno));
     if (rc) {
         fprintf(stderr, "tightknot: %s: %s\n", path, err.message);
@@ -931,9 +962,9 @@ static int write_struts_file(const char *path, const char *name, tk_run *run)
                             kinks, nk, true);
     char *text = tk_json_dump(o, true);
     json_decref(o);
-    FILE *f = text ? fopen(path, "w") : NULL;
+    FILE *f = text ? open_output(path) : NULL;
     int ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
-    if (f && fclose(f) != 0)
+    if (f && close_output(f) != 0)
         ok = 0;
     free(text);
     if (!ok) {
@@ -1027,6 +1058,7 @@ static int cmd_tighten(int argc, char **argv)
         status = EXIT_INPUT;
     if (a.struts_out && write_struts_file(a.struts_out, name, run) != EXIT_OK)
         status = EXIT_INPUT;
+    to_stderr_after(outputs);
     const tk_step_report *last = tk_run_latest(run);
     const tk_curve *fin = tk_run_curve(run);
     if (a.json) {
