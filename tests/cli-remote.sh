@@ -155,6 +155,31 @@ check $? "a deleted job is gone: $(cat "$tmp/gone")"
 [ $? -eq 2 ] && grep -q "no job 999999" "$tmp/missing"
 check $? "status of a missing job: $(cat "$tmp/missing")"
 
+# list: every job the server holds, newest first, as status prints them;
+# a state keeps those in it; --json the job objects; a bad state is named
+"$tk" remote --server "$url" list >"$tmp/list" 2>&1
+check $? "list exits 0: $(head -c 200 "$tmp/list")"
+ids=$(awk -F"	" '$2 != "" {print $2}' "$tmp/out/jobs.tsv" | grep -v "^$first$" |
+    sort -n | tr '\n' ' ')
+[ "$(cut -f 1 "$tmp/list" | sort -n | tr '\n' ' ')" = "$ids" ]
+check $? "list names the jobs submitted and not deleted ($ids): $(cut -f 1 "$tmp/list" | tr '\n' ' ')"
+[ "$(cut -f 1 "$tmp/list" | tr '\n' ' ')" = "$(cut -f 1 "$tmp/list" | sort -rn | tr '\n' ' ')" ]
+check $? "list is newest first"
+for id in $ids; do
+    "$tk" remote --server "$url" status "$id" 2>/dev/null
+done >"$tmp/statuses"
+[ "$(sort "$tmp/list")" = "$(sort "$tmp/statuses")" ]
+check $? "list's lines are status's lines"
+"$tk" remote --server "$url" list done >"$tmp/done" 2>&1
+[ "$(wc -l <"$tmp/done")" -eq "$(grep -c "	done	" "$tmp/list")" ]
+check $? "list done keeps the done jobs: $(wc -l <"$tmp/done")"
+"$tk" remote --server "$url" --json list >"$tmp/list.json" 2>&1
+[ "$(grep -c '^{"' "$tmp/list.json")" -eq "$(wc -l <"$tmp/list")" ]
+check $? "list --json: one object a job"
+"$tk" remote --server "$url" list finished >/dev/null 2>"$tmp/badstate"
+[ $? -eq 1 ] && grep -q "state" "$tmp/badstate"
+check $? "list with a bad state: usage error from the server's message: $(cat "$tmp/badstate")"
+
 # a dead server: a clear message and exit 3
 kill "$pid" && wait "$pid" 2>/dev/null
 pid=""

@@ -45,6 +45,9 @@ const char tk_remote_help[] =
     "      components, vertices, ropelength, thickness, residual, struts, steps,\n"
     "      seconds, state.  Run it again to resume: files already done are not\n"
     "      submitted again and jobs already submitted are followed.\n"
+    "  list [STATE]    every job the server shows you (with tokens, your own),\n"
+    "                  newest first, one line each as status prints; STATE\n"
+    "                  (queued, running, done, failed, cancelled) keeps those\n"
     "  status JOB...   one line per job: state, step, ropelength, residual\n"
     "  cancel JOB...   cancel queued or running jobs\n"
     "  delete JOB...   delete finished jobs (done, failed or cancelled) from\n"
@@ -66,7 +69,7 @@ const char tk_remote_help[] =
     "                 server's certificate, for a private CA (the system's CAs\n"
     "                 otherwise); the server's name is always verified\n"
     "  --poll SECONDS how often to ask for progress (default 1)\n"
-    "  --json         status: print the jobs as JSON, one per line\n"
+    "  --json         status and list: print the jobs as JSON, one per line\n"
     "\n"
     "Exit status: 0 all done, 1 usage error, 2 some job failed or a file was\n"
     "refused, 3 the server could not be reached or answered with an error.\n"
@@ -799,6 +802,85 @@ static bool parse_job_id(const char *text, long long *id)
     return true;
 }
 
+/* One line for a job, as status prints it: id, name, state (or `label`),
+ * step, ropelength, residual, and the error of a failed one; every text
+ * from the server made printable. */
+static void print_job(long long id, json_t *job, const char *label)
+{
+    char name[512], state[64], error[1024], rope[32], resid[32];
+    printable(name, sizeof name, json_string_value(json_object_get(job, "name")));
+    printable(state, sizeof state, json_string_value(json_object_get(job, "state")));
+    printable(error, sizeof error, json_string_value(json_object_get(job, "error")));
+    format_number(rope, sizeof rope, number_or_nan(job, "ropelength"));
+    format_number(resid, sizeof resid, number_or_nan(job, "residual"));
+    printf("%lld\t%s\t%s\tstep %lld\tropelength %s\tresidual %s%s%s\n", id, name,
+           label ? label : state[0] ? state : "?",
+           (long long)json_integer_value(json_object_get(json_object_get(job, "progress"), "step")),
+           rope, resid, error[0] ? "\terror " : "", error);
+}
+
+/* list [STATE]: every job the server shows this client (with tokens, its
+ * own), newest first, fetched LIST_PAGE at a time; one line each as
+ * status prints, or with --json each job's object on a line. */
+#define LIST_PAGE 500
+
+static int cmd_list(client *c, bool json, int argc, char **argv)
+{
+    if (argc > 1) {
+        fprintf(stderr, "tightknot remote list: at most one STATE (queued, running, done, failed "
+                        "or cancelled)\nTry 'tightknot remote --help'.\n");
+        return REMOTE_USAGE;
+    }
+    char *state = argc ? curl_easy_escape(c->curl, argv[0], 0) : NULL;
+    int status = REMOTE_OK;
+    for (long long offset = 0;;) {
+        char path[256];
+        snprintf(path, sizeof path, "/v1/jobs?limit=%d&offset=%lld%s%s", LIST_PAGE, offset,
+                 state ? "&state=" : "", state ? state : "");
+        response r = {0};
+        if (!request(c, "GET", path, NULL, NULL, 0, &r)) {
+            status = REMOTE_SERVER;
+            break;
+        }
+        if (r.status >= 400) {
+            char detail[256];
+            problem_text(&r, detail, sizeof detail);
+            fprintf(stderr, "tightknot remote list: %s\n", detail);
+            status = r.status == 400 ? REMOTE_USAGE : REMOTE_SERVER;
+            free(r.body.data);
+            break;
+        }
+        json_t *page = json_loadb(r.body.data, r.body.len, 0, NULL);
+        free(r.body.data);
+        if (!page) {
+            fprintf(stderr, "tightknot remote list: the server's answer is not JSON\n");
+            status = REMOTE_SERVER;
+            break;
+        }
+        json_t *jobs = json_object_get(page, "jobs"), *job;
+        size_t k;
+        json_array_foreach(jobs, k, job) {
+            if (json) {
+                char *text = json_dumps(job, JSON_COMPACT | JSON_PRESERVE_ORDER |
+                                                 JSON_REAL_PRECISION(17));
+                if (text)
+                    printf("%s\n", text);
+                free(text);
+            } else {
+                print_job((long long)json_integer_value(json_object_get(job, "id")), job, NULL);
+            }
+        }
+        size_t n = json_array_size(jobs);
+        long long total = (long long)json_integer_value(json_object_get(page, "total"));
+        json_decref(page);
+        offset += (long long)n;
+        if (n == 0 || offset >= total)
+            break;
+    }
+    curl_free(state);
+    return status;
+}
+
 static int cmd_jobs(client *c, const char *what, const run_args *a, bool json, int argc,
                     char **argv)
 {
@@ -858,10 +940,8 @@ static int cmd_jobs(client *c, const char *what, const run_args *a, bool json, i
             continue;
         }
         json_t *job = json_loadb(r.body.data, r.body.len, 0, NULL);
-        char name[512], state[64], error[1024];
+        char name[512];
         printable(name, sizeof name, json_string_value(json_object_get(job, "name")));
-        printable(state, sizeof state, json_string_value(json_object_get(job, "state")));
-        printable(error, sizeof error, json_string_value(json_object_get(job, "error")));
         if (json && !cancel) {
             printf("%s\n", r.body.data);
         } else if (!strcmp(what, "fetch")) {
@@ -873,15 +953,7 @@ static int cmd_jobs(client *c, const char *what, const run_args *a, bool json, i
                 printf("job %lld (%s): %s/%s.vect, %s/%s.struts.json\n", id, name,
                        a->out, file, a->out, file);
         } else {
-            char rope[32], resid[32];
-            format_number(rope, sizeof rope, number_or_nan(job, "ropelength"));
-            format_number(resid, sizeof resid, number_or_nan(job, "residual"));
-            printf("%lld\t%s\t%s\tstep %lld\tropelength %s\tresidual %s%s%s\n", id,
-                   name, cancel ? (r.status == 202 ? "cancelling" : "cancelled")
-                                : state[0] ? state : "?",
-                   (long long)json_integer_value(
-                       json_object_get(json_object_get(job, "progress"), "step")),
-                   rope, resid, error[0] ? "\terror " : "", error);
+            print_job(id, job, cancel ? (r.status == 202 ? "cancelling" : "cancelled") : NULL);
         }
         json_decref(job);
         free(r.body.data);
@@ -919,8 +991,8 @@ int tk_remote_main(int argc, char **argv)
         return REMOTE_OK;
     }
     if (npos == 0) {
-        fprintf(stderr, "tightknot remote: no COMMAND given (submit, status, cancel, delete or "
-                        "fetch)\nTry 'tightknot remote --help'.\n");
+        fprintf(stderr, "tightknot remote: no COMMAND given (submit, list, status, cancel, delete "
+                        "or fetch)\nTry 'tightknot remote --help'.\n");
         return REMOTE_USAGE;
     }
     const char *command = argv[0];
@@ -965,12 +1037,14 @@ int tk_remote_main(int argc, char **argv)
     }
     if (!strcmp(command, "submit"))
         status = cmd_submit(&c, &a, nrest, rest);
+    else if (!strcmp(command, "list"))
+        status = cmd_list(&c, json, nrest, rest);
     else if (!strcmp(command, "status") || !strcmp(command, "cancel") ||
              !strcmp(command, "delete") || !strcmp(command, "fetch"))
         status = cmd_jobs(&c, command, &a, json, nrest, rest);
     else {
-        fprintf(stderr, "tightknot remote: unknown command '%s' (submit, status, cancel, "
-                        "delete or fetch)\nTry 'tightknot remote --help'.\n",
+        fprintf(stderr, "tightknot remote: unknown command '%s' (submit, list, status, "
+                        "cancel, delete or fetch)\nTry 'tightknot remote --help'.\n",
                 command);
         status = REMOTE_USAGE;
     }
