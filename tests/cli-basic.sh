@@ -96,6 +96,21 @@ expect_status 0 "tightknot --help" "$tk" --help
 for word in info struts generate ropelength "Exit status"; do
     expect_match "$word" "$tmp/out" "tightknot --help mentions $word"
 done
+"$tk" --help >"$tmp/mainhelp"
+expect_match "^  remote " "$tmp/mainhelp" "tightknot --help lists remote"
+# every shape generate knows (one that it does not know is refused as
+# "unknown shape") is listed by tightknot --help
+for shape in torus figure-eight lissajous hopf borromean chain deform relax turn; do
+    "$tk" generate "$shape" >/dev/null 2>"$tmp/shape"
+    if grep -q "unknown shape" "$tmp/shape"; then
+        fail "generate $shape: $(cat "$tmp/shape")"
+    else
+        pass
+    fi
+    expect_match "$shape" "$tmp/mainhelp" "tightknot --help lists the shape $shape"
+done
+"$tk" generate frobnicate >/dev/null 2>"$tmp/shape"
+expect_match "unknown shape" "$tmp/shape" "an unknown shape is refused as such"
 expect_status 0 "tightknot -h" "$tk" -h
 expect_status 1 "tightknot without a command" "$tk"
 expect_status 1 "unknown command" "$tk" frobnicate
