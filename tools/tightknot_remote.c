@@ -171,11 +171,28 @@ static bool request(client *c, const char *method, const char *path, const char 
     CURLcode rc = curl_easy_perform(h);
     curl_slist_free_all(headers);
     if (rc != CURLE_OK) {
-        fprintf(stderr, "%stightknot remote: cannot reach %s: %s\n", c->tty ? "\n" : "", c->base,
-                c->error[0] ? c->error : curl_easy_strerror(rc));
+        /* a certificate no CA the client trusts signed: say how to trust it */
+        bool certificate = rc == CURLE_PEER_FAILED_VERIFICATION || rc == CURLE_SSL_CACERT_BADFILE;
+        fprintf(stderr, "%stightknot remote: cannot reach %s: %s%s\n", c->tty ? "\n" : "",
+                c->base, c->error[0] ? c->error : curl_easy_strerror(rc),
+                certificate ? " (a self-signed server, or one whose certificate a private CA "
+                              "signed: pass --cacert FILE, that CA's certificate in PEM)"
+                            : "");
         return false;
     }
     curl_easy_getinfo(h, CURLINFO_RESPONSE_CODE, &r->status);
+    if (r->status == 401) {
+        /* every later request would be refused the same way: stop at the
+         * first, as for a server that cannot be reached */
+        fprintf(stderr, "%stightknot remote: %s: %s\n", c->tty ? "\n" : "", c->base,
+                c->token ? "the server refused the token (401): check --token or "
+                           "$TIGHTKNOT_TOKEN"
+                         : "the server needs a token (401): pass --token TOKEN or set "
+                           "$TIGHTKNOT_TOKEN");
+        free(r->body.data);
+        r->body.data = NULL;
+        return false;
+    }
     if (!r->body.data)
         collect("", 1, 0, &r->body);
     return true;

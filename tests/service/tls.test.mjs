@@ -94,6 +94,7 @@ test('the remote client verifies the server with --cacert', async () => {
     const refused = await remote(['status', '1']);
     assert.equal(refused.code, 3);
     assert.match(refused.stderr, /certificate/i);
+    assert.match(refused.stderr, /pass --cacert FILE/, 'the refusal says how to trust the CA');
 });
 
 test('a key that does not fit, or a certificate alone, stops the daemon from starting', async () => {

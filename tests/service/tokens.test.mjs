@@ -151,6 +151,30 @@ test('the remote client sends --token or $TIGHTKNOT_TOKEN', async () => {
     assert.notEqual(other.code, 0, 'alice cannot read carol\'s job');
 });
 
+test('remote submit without a token, or with a wrong one, stops at the first 401 and says how to pass one', async () => {
+    const dir = tempDir();
+    const files = ['a', 'b', 'c'].map((n) => {
+        const f = join(dir, `${n}.vect`);
+        writeFileSync(f, SQUARE);
+        return f;
+    });
+    const run = (args) => new Promise((res) => execFile(CLI, ['remote', '--server', d.base, ...args],
+        { env: { ...process.env, TIGHTKNOT_TOKEN: '' } }, (err, stdout, stderr) =>
+        res({ code: err ? err.code : 0, stdout, stderr })));
+    const listed = async () => (await fetch(`${d.base}/v1/jobs?limit=500`, as('root')).then((x) => x.json())).total;
+    const before = await listed();
+    const bare = await run(['submit', '--steps', '3', '--out', join(dir, 'out'), ...files]);
+    assert.equal(bare.code, 3, bare.stderr);
+    assert.match(bare.stderr, /needs a token \(401\): pass --token TOKEN or set \$TIGHTKNOT_TOKEN/);
+    assert.equal((bare.stderr.match(/401/g) || []).length, 1, `one refusal, not one per file: ${bare.stderr}`);
+    assert.doesNotMatch(bare.stderr, /refused:/, 'no file is marked refused');
+    const wrong = await run(['--token', 'not-a-token-of-the-file', 'submit', '--steps', '3',
+        '--out', join(dir, 'out2'), ...files]);
+    assert.equal(wrong.code, 3, wrong.stderr);
+    assert.match(wrong.stderr, /refused the token \(401\)/);
+    assert.equal(await listed(), before, 'no job was stored');
+});
+
 // Runs the daemon with args until it prints its first line or exits.
 function launch(args) {
     return new Promise((res) => {
