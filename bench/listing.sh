@@ -30,7 +30,7 @@ start() {
         --workers 1 --queue-limit 1000000 --jobs-per-name 0 >"$dir/log" 2>&1 &
     pid=$!
     for _ in $(seq 100); do
-        url=$(sed -n 's|^tightknotd: listening on \(http://[^/]*/\).*|\1|p' "$dir/log")
+        url=$(sed -n 's|^tightknotd: [^ ]* listening on \(http://[^/]*/\).*|\1|p' "$dir/log")
         [ -n "$url" ] && return
         sleep 0.1
     done

@@ -12,6 +12,7 @@
 
 #include "api.h"
 #include "cli.h"
+#include "job.h"
 #include "tk/version.h"
 
 /* The daemon's numbers, each with its domain and default. */
@@ -175,8 +176,12 @@ int main(int argc, char **argv)
         return 2;
     }
     /* a URI may hold a password: only what kind of store it is */
-    printf("tightknotd: listening on %s://%s:%u/ (workers %zu, store %s", tk_api_scheme(server),
-           api.bind, tk_api_port(server), pool_cfg.workers, postgres ? "PostgreSQL" : db);
+    /* every line of the log carries its time, as the pool's job lines do */
+    char now[32];
+    tk_time_iso(now);
+    printf("tightknotd: %s listening on %s://%s:%u/ (workers %zu, store %s", now,
+           tk_api_scheme(server), api.bind, tk_api_port(server), pool_cfg.workers,
+           postgres ? "PostgreSQL" : db);
     if (postgres)
         printf(" as %s, lease %g s", tk_store_holder(store), set.lease);
     if (api.catalogue)
@@ -186,7 +191,8 @@ int main(int argc, char **argv)
     tk_pool_go(pool);
     int sig = 0;
     sigwait(&stop, &sig);
-    printf("tightknotd: %s: storing running jobs and stopping\n",
+    tk_time_iso(now);
+    printf("tightknotd: %s %s: storing running jobs and stopping\n", now,
            sig == SIGINT ? "SIGINT" : "SIGTERM");
     fflush(stdout);
     /* requests get 503; the workers store their jobs and end; the HTTP
@@ -197,6 +203,7 @@ int main(int argc, char **argv)
     tk_pool_free(&pool);
     tk_store_close(&store);
     tk_tokens_free(&tokens);
-    printf("tightknotd: stopped\n");
+    tk_time_iso(now);
+    printf("tightknotd: %s stopped\n", now);
     return 0;
 }

@@ -254,7 +254,7 @@ export async function startDaemon(o = {}) {
         const timer = setTimeout(() => rej(new Error(`daemon did not start in 10 s: ${out}${err}`)), 10000);
         const check = () => {
             const first = out.split('\n')[0];
-            const m = /^tightknotd: listening on http:\/\/127\.0\.0\.1:(\d+)\/ /.exec(first);
+            const m = /^tightknotd: \S+ listening on http:\/\/127\.0\.0\.1:(\d+)\/ /.exec(first);
             if (m && out.includes('\n')) {
                 clearTimeout(timer);
                 res(Number(m[1]));

@@ -144,7 +144,7 @@ describe('SIGTERM with a running job, and restart', () => {
         const seconds = await d1.stop();
         t.diagnostic(`SIGTERM to exit: ${seconds.toFixed(2)} s`);
         assert.match(d1.output(), /SIGTERM: storing running jobs and stopping/);
-        assert.match(d1.output(), /tightknotd: stopped/);
+        assert.match(d1.output(), /tightknotd: \S+ stopped$/m);
 
         const d2 = await startDaemon({ workers: 1, dir, db: d1.db });
         try {

@@ -62,7 +62,7 @@ before(async () => {
     const r = await launch(['--tls-cert', join(dir, 'cert.pem'), '--tls-key', join(dir, 'key.pem')]);
     assert.ok(r.p, `the daemon did not start: ${r.out}${r.err}`);
     proc = r.p;
-    const m = /^tightknotd: listening on https:\/\/127\.0\.0\.1:(\d+)\//.exec(r.out);
+    const m = /^tightknotd: \S+ listening on https:\/\/127\.0\.0\.1:(\d+)\//.exec(r.out);
     assert.ok(m, r.out);
     port = Number(m[1]);
 });

@@ -192,9 +192,9 @@ test('another address than loopback needs tokens or --allow-anonymous; a bad tok
     assert.equal(open.code, 1);
     assert.match(open.err, /--tokens FILE, or --allow-anonymous/);
     const anon = await launch(['--bind', '0.0.0.0', '--port', '0', '--db', db, '--allow-anonymous']);
-    assert.match(anon.out, /^tightknotd: listening on http:\/\/0\.0\.0\.0:\d+\//);
+    assert.match(anon.out, /^tightknotd: \S+ listening on http:\/\/0\.0\.0\.0:\d+\//);
     const tok = await launch(['--bind', '0.0.0.0', '--port', '0', '--db', db, '--tokens', join(dir, 'tokens')]);
-    assert.match(tok.out, /^tightknotd: listening on/);
+    assert.match(tok.out, /^tightknotd: \S+ listening on/);
     writeFileSync(join(dir, 'bad'), 'alice ok-and-long-enough\nbob sha256:12345\n');
     const bad = await launch(['--port', '0', '--db', db, '--tokens', join(dir, 'bad')]);
     assert.equal(bad.code, 2);
