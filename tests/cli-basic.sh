@@ -112,6 +112,34 @@ done
 "$tk" generate frobnicate >/dev/null 2>"$tmp/shape"
 expect_match "unknown shape" "$tmp/shape" "an unknown shape is refused as such"
 expect_status 0 "tightknot -h" "$tk" -h
+
+# a knot by its catalogue name, when no file has that name: from
+# $TIGHTKNOT_CATALOGUE (a copy here), with or without .vect; the same
+# figures as the file's; -o never overwrites the catalogue's file a bare
+# name found (an explicit path may be tightened in place)
+mkdir -p "$tmp/cat"
+"$tk" generate torus 2 5 >"$tmp/cat/5.1.vect"
+"$tk" info "$tmp/cat/5.1.vect" | tail -n 1 | awk '{$1 = ""; print}' >"$tmp/byfile"
+for arg in 5.1 5.1.vect; do
+    (cd "$tmp" && TIGHTKNOT_CATALOGUE="$tmp/cat" "$OLDPWD/$tk" info "$arg") >"$tmp/byname" 2>&1
+    if [ "$(tail -n 1 "$tmp/byname" | awk '{$1 = ""; print}')" = "$(cat "$tmp/byfile")" ]; then
+        pass
+    else
+        fail "info $arg by catalogue name: $(cat "$tmp/byname")"
+    fi
+done
+cp "$tmp/cat/5.1.vect" "$tmp/kept.vect"
+TIGHTKNOT_CATALOGUE="$tmp/cat" "$tk" tighten 5.1 --steps 3 -o "$tmp/cat/5.1.vect" \
+    >/dev/null 2>"$tmp/err"
+status=$?
+if [ "$status" -eq 1 ] && grep -q "names the input" "$tmp/err" &&
+    cmp -s "$tmp/cat/5.1.vect" "$tmp/kept.vect"; then
+    pass
+else
+    fail "tighten NAME -o the catalogue's file: status $status, $(cat "$tmp/err")"
+fi
+(cd "$tmp" && TIGHTKNOT_CATALOGUE="$tmp/cat" "$OLDPWD/$tk" info 9.99) >/dev/null 2>"$tmp/err"
+expect_match "9.99: cannot open" "$tmp/err" "a name in no catalogue is named as given"
 expect_status 1 "tightknot without a command" "$tk"
 expect_status 1 "unknown command" "$tk" frobnicate
 expect_match "frobnicate" "$tmp/err" "unknown command names it"

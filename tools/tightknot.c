@@ -55,6 +55,10 @@ enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_INPUT = 2 };
 
 /* ------------------------------------------------------------ help texts */
 
+/* The catalogue a bare knot name is looked up in when no file has that
+ * name: $TIGHTKNOT_CATALOGUE, else the project's ../shared/catalogue. */
+#define CATALOGUE_DEFAULT "../shared/catalogue"
+
 static const char main_help[] =
     "usage: tightknot COMMAND [OPTIONS] [ARGUMENTS]\n"
     "\n"
@@ -72,6 +76,10 @@ static const char main_help[] =
     "  remote     use a tightknot service: submit files, list, status, cancel,\n"
     "             delete and fetch jobs\n"
     "  help       show the help of a command: tightknot help info\n"
+    "\n"
+    "A FILE is a path, '-' for standard input, or the name of a knot of the\n"
+    "catalogue (tightknot tighten 7.2) when no file has that name: looked up in\n"
+    "$TIGHTKNOT_CATALOGUE, else " CATALOGUE_DEFAULT ".\n"
     "\n"
     "Options:\n"
     "  -h, --help   show this help; 'tightknot COMMAND --help' shows a command's\n"
@@ -415,9 +423,27 @@ static void print_run_options(FILE *out)
 /* ---------------------------------------------------------------- output */
 
 /* The path the engine reads for a command-line file name. */
-static const char *input_path(const char *name)
+/* The file to read for a FILE argument, into buf: "-" (tk_vect_read_file
+ * reads standard input) or an existing file as given; else a name without
+ * a slash ("7.2" or "7.2.vect") found in the catalogue; else as given,
+ * for the read to fail naming it. */
+static const char *input_path(const char *name, char buf[PATH_MAX])
 {
-    return name; /* "-": tk_vect_read_file reads standard input */
+    struct stat st;
+    if (!strcmp(name, "-") || !stat(name, &st) || strchr(name, '/'))
+        return name;
+    const char *env = getenv("TIGHTKNOT_CATALOGUE");
+    const char *dirs[2] = {env && *env ? env : NULL, CATALOGUE_DEFAULT};
+    size_t len = strlen(name);
+    bool has_ext = len > 5 && !strcmp(name + len - 5, ".vect");
+    for (int d = 0; d < 2; d++) {
+        if (!dirs[d])
+            continue;
+        int n = snprintf(buf, PATH_MAX, "%s/%s%s", dirs[d], name, has_ext ? "" : ".vect");
+        if (n > 0 && n < PATH_MAX && !stat(buf, &st) && S_ISREG(st.st_mode))
+            return buf;
+    }
+    return name;
 }
 
 /* Whether two paths name one file: the same file when both exist (links
@@ -448,9 +474,10 @@ static bool same_file(const char *x, const char *y)
 
 /* A run's outputs each a file of its own, and none but -o the input
  * (written at the end, -o IN tightens the file in place; --log and
- * --struts would overwrite the knot before it is read back): refused
- * before any work, as a usage error. */
-static int check_outputs(const char *input, const char *const out[3])
+ * --struts would overwrite the knot before it is read back), and not
+ * even -o when keep_input (a catalogue's file found by a bare name):
+ * refused before any work, as a usage error. */
+static int check_outputs(const char *input, bool keep_input, const char *const out[3])
 {
     static const char *const flag[3] = {"-o", "--struts", "--log"};
     for (int i = 0; i < 3; i++) {
@@ -465,7 +492,7 @@ static int check_outputs(const char *input, const char *const out[3])
                                : same_file(out[i], out[j])))
                 return usage_error("tighten", "%s and %s name one file (%s): each output needs "
                                    "its own", flag[j], flag[i], out[i]);
-        if (i > 0 && strcmp(input, "-") && same_file(out[i], input))
+        if ((i > 0 || keep_input) && strcmp(input, "-") && same_file(out[i], input))
             return usage_error("tighten", "%s names the input %s: it would be lost", flag[i],
                                input);
     }
@@ -509,7 +536,8 @@ static int load_and_measure(const char *name, double tolerance, tk_curve **curve
     tk_error_clear(&err);
     *kinks = NULL;
     *nkinks = 0;
-    if (tk_vect_read_file(input_path(name), NULL, curve, &err) != TK_OK) {
+    char path[PATH_MAX];
+    if (tk_vect_read_file(input_path(name, path), NULL, curve, &err) != TK_OK) {
         report(NULL, &err);
         return EXIT_INPUT;
     }
@@ -781,7 +809,8 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
         if (npos == 3 && parse_integer(cmd, "deform SEED", pos[2], 0, 1LL << 53, &seed))
             return EXIT_USAGE;
         tk_curve *src = NULL;
-        rc = tk_vect_read_file(input_path(pos[1]), NULL, &src, &err);
+        char path[PATH_MAX];
+        rc = tk_vect_read_file(input_path(pos[1], path), NULL, &src, &err);
         if (!rc)
             rc = tk_generate_deform(src, (unsigned long long)seed, DEFORM_KEEP, out, &err);
         tk_curve_free(&src);
@@ -796,7 +825,8 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
         if (npos == 3 && parse_integer(cmd, "relax STEPS", pos[2], 1, INT_MAX, &steps))
             return EXIT_USAGE;
         tk_curve *src = NULL;
-        rc = tk_vect_read_file(input_path(pos[1]), NULL, &src, &err);
+        char path[PATH_MAX];
+        rc = tk_vect_read_file(input_path(pos[1], path), NULL, &src, &err);
         if (!rc)
             rc = tk_relax(src, NULL, 0.0, (int)steps, out, NULL, &err);
         tk_curve_free(&src);
@@ -811,7 +841,8 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
         if (npos == 3 && parse_integer(cmd, "turn SEED", pos[2], 0, 1LL << 53, &seed))
             return EXIT_USAGE;
         tk_curve *src = NULL;
-        rc = tk_vect_read_file(input_path(pos[1]), NULL, &src, &err);
+        char path[PATH_MAX];
+        rc = tk_vect_read_file(input_path(pos[1], path), NULL, &src, &err);
         if (!rc) {
             double offset[3] = {0.0, 0.0, 0.0};
             uint64_t state = (uint64_t)seed;
@@ -1013,12 +1044,16 @@ static int cmd_tighten(int argc, char **argv)
                                       "ropelength to keep)");
     const char *name = a.pos[0];
     const char *const outputs[3] = {a.output, a.struts_out, a.log_out};
-    if (check_outputs(name, outputs) != EXIT_OK)
+    char path[PATH_MAX];
+    const char *input = input_path(name, path);
+    /* -o may rewrite a file in place, not the catalogue's file a bare name
+     * found */
+    if (check_outputs(input, input != name, outputs) != EXIT_OK)
         return EXIT_USAGE;
     tk_error err;
     tk_error_clear(&err);
     tk_curve *c = NULL;
-    if (tk_vect_read_file(input_path(name), NULL, &c, &err) != TK_OK) {
+    if (tk_vect_read_file(input, NULL, &c, &err) != TK_OK) {
         report(NULL, &err);
         return EXIT_INPUT;
     }
