@@ -167,14 +167,22 @@ function fillCatalogue() {
     const keep = sel.value;
     const f = $('catalogue-filter').value.trim().toLowerCase();
     sel.replaceChildren();
-    for (const k of state.catalogue) {
-        if (f && !k.name.toLowerCase().includes(f)) continue;
+    // the name typed exactly comes first, then names that begin with it,
+    // then the others that hold it, each in the catalogue's order
+    const rank = (name) => (name === f ? 0 : name.startsWith(f) ? 1 : 2);
+    const shown = state.catalogue.filter((k) => !f || k.name.toLowerCase().includes(f))
+        .map((k, i) => ({ k, i, r: rank(k.name.toLowerCase()) }))
+        .sort((a, b) => a.r - b.r || a.i - b.i)
+        .map((x) => x.k);
+    for (const k of shown) {
         const o = document.createElement('option');
         o.value = k.name;
         o.textContent = `${k.name}  (${k.components === 1 ? 'knot' : `${k.components}-component link`}, ${k.vertices} vertices)`;
         sel.append(o);
     }
-    if (keep && [...sel.options].some((o) => o.value === keep)) sel.value = keep;
+    const exact = shown.find((k) => k.name.toLowerCase() === f);
+    if (exact) sel.value = exact.name;
+    else if (keep && [...sel.options].some((o) => o.value === keep)) sel.value = keep;
     else if (sel.options.length === 1) sel.selectedIndex = 0;
     updateCatalogueInfo();
 }

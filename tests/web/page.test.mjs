@@ -100,7 +100,15 @@ test('the page and its libraries come from the daemon, with the catalogue', asyn
 
 test('a catalogue knot submitted through the form is tightened and shown', async () => {
     await page.click('#tab-catalogue');
+    // a name typed exactly comes first and is picked (0.3.1 comes before
+    // 3.1 in the catalogue), then the names that begin with it
     await page.fill('#catalogue-filter', '3.1');
+    const options = await page.locator('#catalogue-select option').evaluateAll((os) => os.map((o) => o.value));
+    assert.ok(options.length > 1, `3.1 is held by other names too: ${options.join(' ')}`);
+    assert.equal(options[0], '3.1');
+    const begins = options.filter((n) => n.startsWith('3.1')).length;
+    assert.ok(options.slice(0, begins).every((n) => n.startsWith('3.1')), options.join(' '));
+    assert.equal(await page.inputValue('#catalogue-select'), '3.1');
     await page.selectOption('#catalogue-select', '3.1');
     await setOptions({ resolution: 5, steps: 300, every: 10, time: 0, residual: 0 });
     const id = await submitForm();
