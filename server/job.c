@@ -47,6 +47,7 @@ json_t *tk_job_new(const char *name, const char *owner, const tk_job_options *o,
                             tk_step_fields[i].kind == TK_KIND_REAL ? json_null() : json_integer(0));
     json_object_set_new(doc, "vertices", json_integer((json_int_t)vertices));
     json_object_set_new(doc, "owner", owner ? json_string(owner) : json_null());
+    json_object_set_new(doc, "daemon", json_null());
     tk_job_stamp(doc, "created");
     return doc;
 }

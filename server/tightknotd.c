@@ -182,8 +182,9 @@ int main(int argc, char **argv)
     printf("tightknotd: %s listening on %s://%s:%u/ (workers %zu, store %s", now,
            tk_api_scheme(server), api.bind, tk_api_port(server), pool_cfg.workers,
            postgres ? "PostgreSQL" : db);
+    printf(" as %s", tk_store_holder(store)); /* the jobs' "daemon" */
     if (postgres)
-        printf(" as %s, lease %g s", tk_store_holder(store), set.lease);
+        printf(", lease %g s", set.lease);
     if (api.catalogue)
         printf(", catalogue %s with %zu knots", api.catalogue, tk_api_catalogue_size(server));
     printf(")\n");

@@ -346,6 +346,8 @@ void tk_worker_run(slot *sl, int64_t id)
     if (!rc) {
         pthread_mutex_lock(&p->lock);
         json_object_set_new(doc, "state", json_string("running"));
+        /* which daemon runs it (kept when it ends: which ran it) */
+        json_object_set_new(doc, "daemon", json_string(tk_store_holder(p->store)));
         if (json_is_null(json_object_get(doc, "started")))
             tk_job_stamp(doc, "started");
         json_object_set_new(doc, "components", json_integer((json_int_t)tk_run_curve(jr.run)->ncomp));

@@ -239,3 +239,16 @@ describe('catalogue knot 3.1, resolution 5, 300 steps', () => {
         assert.deepEqual(ids, [...ids].sort((a, b) => b - a), 'newest first');
     });
 });
+
+test('a job says which daemon runs it: none while queued, the one that ran it after', async () => {
+    const m = /listening on \S+ \(workers \d+, store [^)]*? as (\S+?)[,)]/.exec(d.output());
+    assert.ok(m, `the daemon names itself: ${d.output().split('\n')[0]}`);
+    assert.match(m[1], /^[^:]+:\d+:[0-9a-f]{16}$/);
+    const r = await d.post('/v1/jobs', { catalogue: '3.1', options: { steps: 5 } });
+    assert.equal(r.status, 202, r.text);
+    assert.ok('daemon' in r.json, 'the field is there from the start');
+    assert.ok(r.json.daemon === null || r.json.daemon === m[1], r.json.daemon);
+    const job = await waitFinal(d, r.json.id);
+    assert.equal(job.state, 'done');
+    assert.equal(job.daemon, m[1]);
+});
