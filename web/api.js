@@ -10,15 +10,37 @@ export class ApiError extends Error {
     }
 }
 
-// A server started with --tokens answers 401 without a token: the page
-// asks for one and keeps it for the session (this tab) only.
+// A server started with --tokens answers 401 without a token: the page's
+// sign-in field keeps one for the session (this tab) only, and every
+// request sends it.  A 401 is told apart: "token needed" when none was
+// sent, "wrong token" when the one sent was refused; listeners (the
+// sign-in box) hear which, and nothing asks again by itself.
 const TOKEN_KEY = 'tightknot.token';
+const listeners = new Set();
 
-async function request(method, path, options = {}, asked = false) {
+export const auth = {
+    token: () => sessionStorage.getItem(TOKEN_KEY),
+    signIn(token) {
+        sessionStorage.setItem(TOKEN_KEY, token.trim());
+        for (const f of listeners) f('signed-in');
+    },
+    signOut() {
+        sessionStorage.removeItem(TOKEN_KEY);
+        for (const f of listeners) f('signed-out');
+    },
+    onChange: (f) => listeners.add(f),
+};
+
+function headersFor(init) {
+    const token = auth.token();
+    if (token) init.headers.Authorization = `Bearer ${token}`;
+    return token;
+}
+
+async function request(method, path, options = {}) {
     const { json, text, signal } = options;
     const init = { method, headers: { Accept: 'application/json' }, signal, cache: 'no-store' };
-    const token = sessionStorage.getItem(TOKEN_KEY);
-    if (token) init.headers.Authorization = `Bearer ${token}`;
+    const token = headersFor(init);
     if (json !== undefined) {
         init.headers['Content-Type'] = 'application/json';
         init.body = JSON.stringify(json);
@@ -40,15 +62,13 @@ async function request(method, path, options = {}, asked = false) {
     } else {
         body = await res.text();
     }
-    if (res.status === 401 && !asked) {
-        // another request may have asked meanwhile
-        const now = sessionStorage.getItem(TOKEN_KEY);
-        if (now && now !== token) return request(method, path, options, true);
-        const given = window.prompt(`${body?.detail || 'This server needs a token.'}\nYour token:`);
-        if (given) {
-            sessionStorage.setItem(TOKEN_KEY, given.trim());
-            return request(method, path, options, true);
-        }
+    if (res.status === 401) {
+        const why = token ? 'wrong-token' : 'token-needed';
+        for (const f of listeners) f(why);
+        throw new ApiError(401, { ...(body && typeof body === 'object' ? body : {}), status: 401,
+            title: token ? 'Wrong token' : 'Token needed',
+            detail: token ? 'the server refused this token: sign in with another'
+                : 'this server needs a token: sign in with yours' });
     }
     if (!res.ok) {
         const problem = body && typeof body === 'object' ? body
@@ -71,5 +91,26 @@ export const api = {
     history: (id, limit = 1000, o) => request('GET', `/v1/jobs/${id}/history?limit=${limit}`, o),
     frames: (id, offset, limit, o) => request('GET', `/v1/jobs/${id}/frames?offset=${offset}&limit=${limit}`, o),
 };
+
+// A job's file fetched with the token (a bare link would send none) and
+// saved under `name` from a blob.
+export async function download(path, name) {
+    const init = { headers: {}, cache: 'no-store' };
+    const token = headersFor(init);
+    const res = await fetch(path, init);
+    if (res.status === 401) {
+        for (const f of listeners) f(token ? 'wrong-token' : 'token-needed');
+        throw new ApiError(401, { title: token ? 'Wrong token' : 'Token needed', status: 401 });
+    }
+    if (!res.ok) throw new ApiError(res.status, { title: res.statusText || `HTTP ${res.status}`, status: res.status });
+    const url = URL.createObjectURL(await res.blob());
+    const a = document.createElement('a');
+    a.href = url;
+    a.download = name;
+    document.body.append(a);
+    a.click();
+    a.remove();
+    setTimeout(() => URL.revokeObjectURL(url), 10000);
+}
 
 export const TERMINAL = new Set(['done', 'failed', 'cancelled']);

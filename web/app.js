@@ -1,6 +1,6 @@
 // The page: submit a knot, watch its job, look at the result, replay it.
 
-import { api, ApiError, TERMINAL } from './api.js';
+import { api, ApiError, auth, download, TERMINAL } from './api.js';
 import { parseVect, splitFlat, torusLink, scaleToFit, writeVect } from './geometry.js';
 import { drawHistory, drawContactMap, fmtForce } from './charts.js';
 import { createView, forceColour, rampCss } from './view3d.js';
@@ -461,13 +461,14 @@ function showJob(job) {
         box.hidden = false;
     }
     $('job-cancel').disabled = TERMINAL.has(job.state);
+    // fetched with the token and saved from a blob (downloadFile)
     const links = [['job-download-vect', `/v1/jobs/${job.id}/vect`, fileName(job, '.vect')],
         ['job-download-struts', `/v1/jobs/${job.id}/struts`, fileName(job, '-struts.json')]];
     for (const [id, href, name] of links) {
-        const a = $(id);
-        a.href = href;
-        a.download = name;
-        a.setAttribute('aria-disabled', String(job.state === 'queued'));
+        const b = $(id);
+        b.dataset.href = href;
+        b.dataset.name = name;
+        b.disabled = job.state === 'queued';
     }
     const steps = job.options.steps;
     $('fig-step-label').textContent = steps ? `step of ${compact(steps)}` : 'step';
@@ -715,6 +716,50 @@ async function refreshHealth() {
     }
 }
 
+// ------------------------------------------------------------------ sign-in
+
+// The sign-in box: what the last answer said of the token (none needed so
+// far, signed in, token needed, wrong token), sign in and sign out.
+const SIGNIN_TEXT = {
+    none: '',
+    'signed-in': 'signed in',
+    'signed-out': 'signed out',
+    'token-needed': 'this server needs a token: sign in',
+    'wrong-token': 'wrong token: the server refused it',
+};
+
+function showSignIn(what) {
+    const st = $('signin-state');
+    // a 401 of a request sent before signing in says nothing of the new token
+    if (what === 'token-needed' && auth.token()) return;
+    st.dataset.state = what;
+    st.textContent = SIGNIN_TEXT[what] ?? what;
+    const signedIn = Boolean(auth.token());
+    $('signout-button').hidden = !signedIn;
+    if (what === 'token-needed' || what === 'wrong-token') $('signin-token').focus();
+}
+
+function signIn(e) {
+    e.preventDefault();
+    const token = $('signin-token').value.trim();
+    if (!token) return;
+    $('signin-token').value = '';
+    auth.signIn(token);
+    loadCatalogue();
+    refreshJobs();
+    if (state.selected) selectJob(state.selected);
+}
+
+async function downloadFile(e) {
+    const b = e.currentTarget;
+    if (!b.dataset.href) return;
+    try {
+        await download(b.dataset.href, b.dataset.name);
+    } catch (err) {
+        showProblem($('job-error'), err);
+    }
+}
+
 // ------------------------------------------------------------------ wiring
 
 function wire() {
@@ -749,6 +794,11 @@ function wire() {
     $('jobs-newer').addEventListener('click', () => { state.jobsOffset = Math.max(0, state.jobsOffset - state.jobsLimit); refreshJobs(); });
     $('jobs-older').addEventListener('click', () => { state.jobsOffset += state.jobsLimit; refreshJobs(); });
     $('job-cancel').addEventListener('click', cancelJob);
+    $('job-download-vect').addEventListener('click', downloadFile);
+    $('job-download-struts').addEventListener('click', downloadFile);
+    $('signin').addEventListener('submit', signIn);
+    $('signout-button').addEventListener('click', () => { auth.signOut(); refreshJobs(); });
+    auth.onChange(showSignIn);
 
     $('strut-table').tHead.addEventListener('click', (e) => {
         const th = e.target.closest('th[data-key]');
@@ -780,6 +830,7 @@ function wire() {
 
 function start() {
     wire();
+    showSignIn(auth.token() ? 'signed-in' : 'none');
     setSource('catalogue');
     loadCatalogue();
     refreshJobs();

@@ -14,7 +14,7 @@
 
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync, writeFileSync } from 'node:fs';
+import { mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
 import { createServer } from 'node:http';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -123,35 +123,56 @@ test('a name that is not the daemon\'s (DNS rebinding) gets 421, the page and th
     }
 });
 
-test('with --tokens the page asks for a token once, keeps it for the session, and lists the jobs', async () => {
+test('with --tokens: the page says a token is needed, tells a wrong one apart, signs in and out, and downloads with it', async () => {
     const dir = mkdtempSync(join(tmpdir(), 'tk-web-tokens-'));
     writeFileSync(join(dir, 'tokens'), 'ann ann-token-00000001\n');
     const d = await startDaemon(['--tokens', join(dir, 'tokens')]);
-    const context = await browser.newContext();
+    const context = await browser.newContext({ acceptDownloads: true });
     const p = await context.newPage();
     try {
         const job = await api(d.base, '/v1/jobs?steps=3', { method: 'POST',
             headers: { 'Content-Type': 'text/plain', Authorization: 'Bearer ann-token-00000001' }, body: SQUARE });
         assert.equal(job.status, 202);
-        const asked = [];
-        p.on('dialog', async (dialog) => {
-            asked.push(dialog.message());
-            await dialog.accept('ann-token-00000001');
-        });
+        const dialogs = [];
+        p.on('dialog', async (dialog) => { dialogs.push(dialog.message()); await dialog.dismiss(); });
         await p.goto(`${d.base}/`);
-        // the catalogue loads once the token is given
+        const state = () => p.locator('#signin-state').getAttribute('data-state');
+        await p.waitForFunction(() => document.getElementById('signin-state').dataset.state === 'token-needed');
+        assert.match(await p.locator('#signin-state').innerText(), /needs a token/);
+        // a wrong token is told apart from none
+        await p.fill('#signin-token', 'not-the-token-0000');
+        await p.click('#signin-button');
+        await p.waitForFunction(() => document.getElementById('signin-state').dataset.state === 'wrong-token');
+        assert.match(await p.locator('#signin-state').innerText(), /wrong token/);
+        // the right one: the catalogue and the job list load, and the
+        // field keeps nothing shown
+        await p.fill('#signin-token', 'ann-token-00000001');
+        await p.click('#signin-button');
         await p.waitForFunction(() => document.querySelectorAll('#catalogue-select option').length > 0,
             null, { timeout: 20000 });
-        assert.equal(asked.length, 1, `asked ${asked.length} times: ${asked.join(' | ')}`);
-        assert.match(asked[0], /needs a token/);
+        assert.equal(await state(), 'signed-in');
+        assert.equal(await p.inputValue('#signin-token'), '');
         assert.equal(await p.evaluate(() => sessionStorage.getItem('tightknot.token')), 'ann-token-00000001');
-        // its job is listed: the page's requests carry the token
-        const listed = await p.evaluate(async () => (await fetch('/v1/jobs', {
-            headers: { Authorization: `Bearer ${sessionStorage.getItem('tightknot.token')}` } })).json());
-        assert.equal(listed.total, 1);
+        await p.waitForFunction((id) => document.querySelector(`#jobs-table tr[data-id="${id}"]`) !== null,
+            job.body.id, { timeout: 20000 });
+        // the job's files download with the token (a bare link would get 401)
+        await p.goto(`${d.base}/#job=${job.body.id}`);
+        await p.waitForFunction(() => !document.getElementById('job-download-vect').disabled, null, { timeout: 20000 });
+        const [vect] = await Promise.all([p.waitForEvent('download'), p.click('#job-download-vect')]);
+        const text = readFileSync(await vect.path(), 'utf8');
+        const direct = await api(d.base, `/v1/jobs/${job.body.id}/vect`, { headers: { Authorization: 'Bearer ann-token-00000001' } });
+        assert.equal(text, direct.body);
+        assert.match(vect.suggestedFilename(), new RegExp(`-${job.body.id}\\.vect$`));
+        // kept for the session; nothing ever prompts
         await p.reload();
         await p.waitForFunction(() => document.querySelectorAll('#catalogue-select option').length > 0);
-        assert.equal(asked.length, 1, 'not asked again in the same session');
+        assert.equal(await state(), 'signed-in');
+        // signed out: the token is gone and the next answer says one is needed
+        await p.click('#signout-button');
+        assert.equal(await p.evaluate(() => sessionStorage.getItem('tightknot.token')), null);
+        await p.waitForFunction(() => document.getElementById('signin-state').dataset.state === 'token-needed',
+            null, { timeout: 20000 });
+        assert.deepEqual(dialogs, [], 'no dialog');
     } finally {
         await context.close();
         await d.stop();
