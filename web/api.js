@@ -92,9 +92,9 @@ export const api = {
     frames: (id, offset, limit, o) => request('GET', `/v1/jobs/${id}/frames?offset=${offset}&limit=${limit}`, o),
 };
 
-// A job's file fetched with the token (a bare link would send none) and
-// saved under `name` from a blob.
-export async function download(path, name) {
+// A job's file fetched with the token (a bare link would send none), as a
+// blob for the page to save.
+export async function fetchFile(path) {
     const init = { headers: {}, cache: 'no-store' };
     const token = headersFor(init);
     const res = await fetch(path, init);
@@ -103,14 +103,7 @@ export async function download(path, name) {
         throw new ApiError(401, { title: token ? 'Wrong token' : 'Token needed', status: 401 });
     }
     if (!res.ok) throw new ApiError(res.status, { title: res.statusText || `HTTP ${res.status}`, status: res.status });
-    const url = URL.createObjectURL(await res.blob());
-    const a = document.createElement('a');
-    a.href = url;
-    a.download = name;
-    document.body.append(a);
-    a.click();
-    a.remove();
-    setTimeout(() => URL.revokeObjectURL(url), 10000);
+    return res.blob();
 }
 
 export const TERMINAL = new Set(['done', 'failed', 'cancelled']);

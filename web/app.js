@@ -1,6 +1,6 @@
 // The page: submit a knot, watch its job, look at the result, replay it.
 
-import { api, ApiError, auth, download, TERMINAL } from './api.js';
+import { api, ApiError, auth, fetchFile, TERMINAL } from './api.js';
 import { parseVect, splitFlat, torusLink, scaleToFit, writeVect } from './geometry.js';
 import { drawHistory, drawContactMap, fmtForce } from './charts.js';
 import { createView, forceColour, rampCss } from './view3d.js';
@@ -754,10 +754,57 @@ async function downloadFile(e) {
     const b = e.currentTarget;
     if (!b.dataset.href) return;
     try {
-        await download(b.dataset.href, b.dataset.name);
+        saveBlob(await fetchFile(b.dataset.href), b.dataset.name);
     } catch (err) {
         showProblem($('job-error'), err);
     }
+}
+
+// ------------------------------------------------------------------ exports
+
+function saveBlob(blob, name) {
+    const url = URL.createObjectURL(blob);
+    const a = document.createElement('a');
+    a.href = url;
+    a.download = name;
+    document.body.append(a);
+    a.click();
+    a.remove();
+    setTimeout(() => URL.revokeObjectURL(url), 10000);
+}
+
+// The page styles its SVG figures from style.css; a file on its own needs
+// the styles that apply written on each element.
+const SVG_STYLES = ['fill', 'fill-opacity', 'stroke', 'stroke-opacity', 'stroke-width',
+    'stroke-dasharray', 'opacity', 'font-family', 'font-size', 'font-weight', 'text-anchor',
+    'dominant-baseline'];
+
+function standaloneSvg(svg) {
+    const copy = svg.cloneNode(true);
+    const from = [svg, ...svg.querySelectorAll('*')], to = [copy, ...copy.querySelectorAll('*')];
+    for (let i = 0; i < from.length; i++) {
+        const cs = getComputedStyle(from[i]);
+        to[i].setAttribute('style', SVG_STYLES.map((k) => `${k}: ${cs.getPropertyValue(k)}`).join('; '));
+        // presentation attributes naming the page's variables: the style
+        // written above holds their values
+        for (const k of SVG_STYLES) if (to[i].getAttribute(k)?.includes('var(')) to[i].removeAttribute(k);
+    }
+    const box = svg.viewBox.baseVal;
+    copy.setAttribute('xmlns', 'http://www.w3.org/2000/svg');
+    copy.setAttribute('width', String(box.width));
+    copy.setAttribute('height', String(box.height));
+    return new Blob(['<?xml version="1.0" encoding="UTF-8"?>\n', new XMLSerializer().serializeToString(copy)],
+        { type: 'image/svg+xml' });
+}
+
+function exportName(what) {
+    return state.job ? fileName(state.job, `-${what}`) : `tightknot-${what}`;
+}
+
+async function exportPng() {
+    if (!view || view.unavailable) return;
+    const blob = await view.png();
+    if (blob) saveBlob(blob, exportName('view.png'));
 }
 
 // ------------------------------------------------------------------ wiring
@@ -821,6 +868,9 @@ function wire() {
     $('show-struts').addEventListener('change', () => view?.setShowStruts($('show-struts').checked));
     $('tube-opacity').addEventListener('input', () => view?.setOpacity(Number($('tube-opacity').value)));
     $('fit-view').addEventListener('click', () => view?.fit());
+    $('export-png').addEventListener('click', exportPng);
+    $('export-chart').addEventListener('click', () => saveBlob(standaloneSvg($('chart')), exportName('ropelength.svg')));
+    $('export-map').addEventListener('click', () => saveBlob(standaloneSvg($('contact-map')), exportName('contacts.svg')));
 
     window.addEventListener('hashchange', () => {
         const m = /^#job=(\d+)$/.exec(location.hash);

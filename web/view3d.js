@@ -113,6 +113,12 @@ export class View3D {
         });
     }
 
+    // The picture as a PNG blob (rendered now: the canvas read back).
+    png() {
+        this.renderer.render(this.scene, this.camera);
+        return new Promise((res) => this.renderer.domElement.toBlob(res, 'image/png'));
+    }
+
     // Renders now; callers reading the canvas back want the current picture.
     renderNow() {
         this.renderer.render(this.scene, this.camera);

@@ -233,6 +233,38 @@ test('the final VECT and the struts JSON download', async () => {
     assert.deepEqual(got, (await api(`/v1/jobs/${id}/struts`)).body);
 });
 
+test('the 3-D view exports as PNG, the chart and the contact map as SVG files of their own', async () => {
+    const id = shared.trefoil;
+    const { body: job } = await api(`/v1/jobs/${id}`);
+    const { body: contacts } = await api(`/v1/jobs/${id}/struts`);
+    const [png] = await Promise.all([page.waitForEvent('download'), page.click('#export-png')]);
+    const bytes = readFileSync(await png.path());
+    assert.deepEqual([...bytes.subarray(0, 8)], [0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a], 'a PNG');
+    const canvas = await page.evaluate(() => { const c = document.querySelector('#view3d canvas'); return [c.width, c.height]; });
+    assert.deepEqual([bytes.readUInt32BE(16), bytes.readUInt32BE(20)], canvas, 'the canvas, pixel for pixel in size');
+    assert.equal(png.suggestedFilename(), `${job.name}-${id}-view.png`);
+    for (const [button, name, check] of [
+        ['#export-chart', 'ropelength.svg', (doc) => assert.equal(doc.match(/class="curve"/g)?.length, 1)],
+        ['#export-map', 'contacts.svg', (doc) => assert.equal(doc.match(/class="strut-mark/g)?.length, contacts.struts.length)],
+    ]) {
+        const [svg] = await Promise.all([page.waitForEvent('download'), page.click(button)]);
+        const text = readFileSync(await svg.path(), 'utf8');
+        assert.equal(svg.suggestedFilename(), `${job.name}-${id}-${name}`);
+        assert.match(text, /^<\?xml [^>]*>\n<svg [^>]*xmlns="http:\/\/www\.w3\.org\/2000\/svg"/);
+        check(text);
+        // it stands alone: parsed by the browser as an image, drawn with
+        // its own styles (no stylesheet)
+        const drawn = await page.evaluate(async (t) => {
+            const img = new Image();
+            img.src = URL.createObjectURL(new Blob([t], { type: 'image/svg+xml' }));
+            await img.decode();
+            return [img.naturalWidth, img.naturalHeight];
+        }, text);
+        assert.ok(drawn[0] > 0 && drawn[1] > 0, `drawn ${drawn}`);
+        assert.doesNotMatch(text, /var\(--/, 'no stylesheet variable left unresolved');
+    }
+});
+
 test('a bad VECT is rejected with the problem\'s detail and line', async () => {
     const bad = 'VECT\n1 4 0\n-4\n0\n0 0 0\n4 0 0\nfoo 4 0\n0 4 0\n';
     const direct = await api('/v1/jobs', {
