@@ -13,8 +13,9 @@
 // (the client's summary.tsv and one VECT and contacts file a start), and
 // the table of every knot done so far, over every slice run into OUT, is
 // written to TABLE: its type, the ropelength of each start, the lowest,
-// the spread between starts, the struts and kinks and seconds of the
-// lowest, the starts whose result's type (measured again with `tightknot
+// the spread between starts, how many of the lowest start's tightenings
+// reached its lowest basin (the job's basins.best_reached; 1: found once),
+// the struts and kinks and seconds of the lowest, the starts whose result's type (measured again with `tightknot
 // info`) is not the file's, the settings.  Then a summary: how many knots
 // have every start within 0.1% of their lowest, the widest spreads, how
 // often the catalogue's own start was the one trapped, and by how much.
@@ -227,13 +228,17 @@ function readSummary() {
     return rows;
 }
 
+// The client's summary.tsv: name, components, vertices, ropelength,
+// thickness, residual, struts, steps, seconds, [reached,] state (a row
+// the client kept from before it wrote `reached` has none).
 function readRows(path, dir, rows) {
     for (const line of readFileSync(path, 'utf8').split('\n')) {
         const f = line.split('\t');
         if (f.length < 10 || f[0] === 'name') continue;
-        const [name, components, vertices, ropelength, thickness, residual, struts, steps, seconds, state] = f;
+        const [name, components, vertices, ropelength, , , struts, steps, seconds] = f;
         rows.set(name, { name, components: +components, vertices: +vertices, ropelength: +ropelength,
-            struts: +struts, steps: +steps, seconds: +seconds, state, dir });
+            struts: +struts, steps: +steps, seconds: +seconds, reached: f.length > 10 ? f[9] : '',
+            state: f.at(-1), dir });
     }
 }
 
@@ -258,7 +263,8 @@ function writeTable() {
     }
     const settings = `resolution ${opt.resolution}, ${opt.seconds} s a start, autoscale, default escapes`;
     const lines = [['name', 'components', 'type', 'vertices', 'starts', 'lowest', 'lowest.start',
-        'spread.%', 'cat.above.%', 'struts', 'kinks', 'seconds', 'failed', 'type.changed', 'settings'].join('\t')];
+        'spread.%', 'cat.above.%', 'lowest.reached', 'struts', 'kinks', 'seconds', 'failed', 'type.changed',
+        'settings'].join('\t')];
     const summary = { knots: 0, compared: 0, agree: 0, spreads: [], catTrapped: [], failed: [], changed: [] };
     for (const knot of [...byKnot.keys()].sort(natural)) {
         const starts = byKnot.get(knot).sort((a, b) => natural(a.tag, b.tag));
@@ -288,7 +294,7 @@ function writeTable() {
         lines.push([knot, best.components, type, best.vertices,
             ok.map((s) => `${s.tag}=${s.ropelength.toFixed(6)}`).join(' '), best.ropelength.toFixed(6),
             best.tag, spread.toFixed(4), Number.isFinite(catAbove) ? catAbove.toFixed(4) : '',
-            best.struts, kinksOf(`${knot}@${best.tag}`, best.dir),
+            best.reached, best.struts, kinksOf(`${knot}@${best.tag}`, best.dir),
             ok.reduce((t, s) => t + s.seconds, 0).toFixed(0), failed.length,
             want ? changed.join(' ') || 'none' : '', settings].join('\t'));
         summary.knots++;

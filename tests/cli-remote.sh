@@ -67,12 +67,12 @@ check $? "submit exits 0: $(tail -n 3 "$tmp/stderr")"
 rows=$(($(wc -l <"$tmp/out/summary.tsv") - 1))
 [ "$rows" -eq "$files" ]
 check $? "summary has $rows rows for $files files"
-head -n 1 "$tmp/out/summary.tsv" | grep -q "^name	components	vertices	ropelength	thickness	residual	struts	steps	seconds	state$"
+head -n 1 "$tmp/out/summary.tsv" | grep -q "^name	components	vertices	ropelength	thickness	residual	struts	steps	seconds	reached	state$"
 check $? "summary header: $(head -n 1 "$tmp/out/summary.tsv")"
 
 # every row is the server's own record of that file's job
 tail -n +2 "$tmp/out/summary.tsv" >"$tmp/rows"
-while IFS="	" read -r name comps verts rope thick resid struts steps secs state; do
+while IFS="	" read -r name comps verts rope thick resid struts steps secs reached state; do
     [ "$state" = done ]
     check $? "$name: state $state"
     # the unlink reaches its critical point (two round circles, residual
@@ -94,6 +94,9 @@ while IFS="	" read -r name comps verts rope thick resid struts steps secs state;
         awk -v a="$mine" -v b="$theirs" 'BEGIN { exit !(a == b && a + 0 > 0) }'
         check $? "$name: $field $mine in the summary, $theirs on the server"
     done
+    theirs=$(sed -n 's/.*"best_reached":\([0-9]*\).*/\1/p' "$tmp/job.json")
+    [ -n "$theirs" ] && [ "$reached" = "$theirs" ]
+    check $? "$name: reached $reached in the summary, best_reached $theirs on the server"
     grep -q "\"name\":\"$name\"" "$tmp/job.json"
     check $? "$name: job $id is named $name"
     [ -s "$tmp/out/$name.vect" ] && "$tk" info "$tmp/out/$name.vect" --json >"$tmp/info.json"

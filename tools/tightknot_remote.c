@@ -43,7 +43,8 @@ const char tk_remote_help[] =
     "      tightknot-results): NAME.vect (the tight curve), NAME.struts.json\n"
     "      (struts and kinks) and a row of DIR/summary.tsv with name,\n"
     "      components, vertices, ropelength, thickness, residual, struts, steps,\n"
-    "      seconds, state.  Run it again to resume: files already done are not\n"
+    "      seconds, reached (how many of the run's tightenings reached its\n"
+    "      lowest basin), state.  Run it again to resume: files already done are not\n"
     "      submitted again and jobs already submitted are followed.\n"
     "  list [STATE]    every job the server shows you (with tokens, your own),\n"
     "                  newest first, one line each as status prints; STATE\n"
@@ -299,7 +300,7 @@ typedef struct item {
     item_phase phase;
     char state[16];      /* the job's state when finished */
     double ropelength, thickness, residual, seconds;
-    long long components, vertices, struts, steps;
+    long long components, vertices, struts, steps, reached;
     char *row;           /* summary row, once finished */
     char message[256];
 } item;
@@ -395,7 +396,8 @@ static item *find_item(item *items, size_t n, const char *name)
 }
 
 static const char summary_header[] =
-    "name\tcomponents\tvertices\tropelength\tthickness\tresidual\tstruts\tsteps\tseconds\tstate\n";
+    "name\tcomponents\tvertices\tropelength\tthickness\tresidual\tstruts\tsteps\tseconds\treached\t"
+    "state\n";
 
 /* Calls take(line, item) for every line of DIR/file whose first field
  * names one of the items (a missing file has no lines). */
@@ -531,6 +533,9 @@ static void finish_item(item *it, const json_t *job)
     it->struts = (long long)json_integer_value(json_object_get(job, "struts"));
     it->steps = (long long)json_integer_value(
         json_object_get(json_object_get(job, "progress"), "step"));
+    /* how many of the run's tightenings reached its lowest basin */
+    it->reached = (long long)json_integer_value(
+        json_object_get(json_object_get(job, "basins"), "best_reached"));
     const char *error = json_string_value(json_object_get(job, "error"));
     if (error)
         printable(it->message, sizeof it->message, error);
@@ -547,9 +552,9 @@ static void make_row(item *it)
     free(it->row);
     it->row = malloc(n);
     if (it->row)
-        snprintf(it->row, n, "%s\t%lld\t%lld\t%s\t%s\t%s\t%lld\t%lld\t%s\t%s\n", it->name,
-                 it->components, it->vertices, rope, thick, resid, it->struts, it->steps, secs,
-                 it->state);
+        snprintf(it->row, n, "%s\t%lld\t%lld\t%s\t%s\t%s\t%lld\t%lld\t%s\t%lld\t%s\n",
+                 it->name, it->components, it->vertices, rope, thick, resid, it->struts,
+                 it->steps, secs, it->reached, it->state);
 }
 
 /* Submits one file; returns REMOTE_OK, REMOTE_FAILED (the server refused the file:
