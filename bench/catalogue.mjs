@@ -5,7 +5,7 @@
 // For each knot or link of the slice it makes starts of different shapes
 // with the catalogue file's type (checked with `tightknot info` before
 // any is submitted): the catalogue file itself, far deformations of it
-// (`tightknot generate deform`, one per seed), the file turned inside out
+// made by isotopy (`tightknot generate wander`, one per seed), the file turned inside out
 // (`tightknot generate turn`: about its centroid, then points near it,
 // one per seed), and the parametric forms
 // whose type is the file's (torus knots and links, chains).  They are
@@ -13,7 +13,8 @@
 // (the client's summary.tsv and one VECT and contacts file a start), and
 // the table of every knot done so far, over every slice run into OUT, is
 // written to TABLE: its type, the ropelength of each start, the lowest,
-// the spread between starts, how many of the lowest start's tightenings
+// the spread between the starts that converged (residual below 0.05; the
+// others are listed apart, as still moving), how many of the lowest start's tightenings
 // reached its lowest basin (the job's basins.best_reached; 1: found once),
 // the struts and kinks and seconds of the lowest, the starts whose result's type (measured again with `tightknot
 // info`) is not the file's, the settings.  Then a summary: how many knots
@@ -33,7 +34,7 @@
 //   --slice K/N       the K-th of N slices (default 1/1: all)
 //   --seconds S       wall time per start (default 60)
 //   --resolution R    vertices per unit ropelength (default 5)
-//   --far K           far deformations per knot, seeds 1..K (default 1)
+//   --far K           far starts per knot (generate wander), seeds 1..K (default 1)
 //   --turn K          turned starts per knot, seeds 0..K-1 (default 1)
 //   --parallel N      starts running at once (default: the cores)
 //   --out DIR         work directory (default build/catalogue)
@@ -168,10 +169,13 @@ function makeStarts(name) {
         files.push(path);
     };
     put('cat', readFileSync(file, 'utf8'), 'catalogue file');
+    // far starts by isotopy (generate wander): a displacement applied at
+    // once (generate deform) made 8.2.3's far start another link with the
+    // same invariants, which ended 35% below the file's
     for (let s = 1; s <= opt.far; s++) {
-        const r = spawnSync(CLI, ['generate', 'deform', file, String(s)], { encoding: 'utf8' });
-        if (r.status === 0) put(`far${s}`, r.stdout, `deformation ${s}`);
-        else console.log(`  ${name}: no deformation ${s}: ${r.stderr.trim()}`);
+        const r = spawnSync(CLI, ['generate', 'wander', file, String(s)], { encoding: 'utf8' });
+        if (r.status === 0) put(`wander${s}`, r.stdout, `wandered start ${s}`);
+        else console.log(`  ${name}: no wandered start ${s}: ${r.stderr.trim()}`);
     }
     for (let s = 0; s < opt.turn; s++) {
         const r = spawnSync(CLI, ['generate', 'turn', file, String(s)], { encoding: 'utf8' });
@@ -235,10 +239,10 @@ function readRows(path, dir, rows) {
     for (const line of readFileSync(path, 'utf8').split('\n')) {
         const f = line.split('\t');
         if (f.length < 10 || f[0] === 'name') continue;
-        const [name, components, vertices, ropelength, , , struts, steps, seconds] = f;
+        const [name, components, vertices, ropelength, , residual, struts, steps, seconds] = f;
         rows.set(name, { name, components: +components, vertices: +vertices, ropelength: +ropelength,
-            struts: +struts, steps: +steps, seconds: +seconds, reached: f.length > 10 ? f[9] : '',
-            state: f.at(-1), dir });
+            residual: +residual, struts: +struts, steps: +steps, seconds: +seconds,
+            reached: f.length > 10 ? f[9] : '', state: f.at(-1), dir });
     }
 }
 
@@ -250,6 +254,8 @@ function kinksOf(start, dir) {
         return '';
     }
 }
+
+const CONVERGED = 0.05;
 
 function writeTable() {
     const rows = readSummary();
@@ -264,18 +270,29 @@ function writeTable() {
     const settings = `resolution ${opt.resolution}, ${opt.seconds} s a start, autoscale, default escapes`;
     const lines = [['name', 'components', 'type', 'vertices', 'starts', 'lowest', 'lowest.start',
         'spread.%', 'cat.above.%', 'lowest.reached', 'struts', 'kinks', 'seconds', 'failed', 'type.changed',
-        'settings'].join('\t')];
-    const summary = { knots: 0, compared: 0, agree: 0, spreads: [], catTrapped: [], failed: [], changed: [] };
+        'unconverged', 'settings'].join('\t')];
+    const summary = { knots: 0, compared: 0, agree: 0, spreads: [], catTrapped: [], failed: [], changed: [],
+        unconverged: [] };
     for (const knot of [...byKnot.keys()].sort(natural)) {
         const starts = byKnot.get(knot).sort((a, b) => natural(a.tag, b.tag));
         const ok = starts.filter((s) => s.state === 'done' && Number.isFinite(s.ropelength));
         const failed = starts.filter((s) => s.state !== 'done');
         for (const s of failed) summary.failed.push(`${knot}@${s.tag}: ${s.state}`);
         if (!ok.length) continue;
-        const best = ok.reduce((a, b) => (b.ropelength < a.ropelength ? b : a));
-        const worst = ok.reduce((a, b) => (b.ropelength > a.ropelength ? b : a));
+        // A start still moving when its time ran out (residual at least
+        // CONVERGED: a loose start whose polygon was reckoned from its own
+        // length, say) has not reached a basin to compare: the spread and
+        // the catalogue's excess are over the converged starts, and the
+        // others are listed apart.
+        const converged = ok.filter((s) => s.residual < CONVERGED);
+        const unconverged = ok.filter((s) => !(s.residual < CONVERGED));
+        for (const s of unconverged)
+            summary.unconverged.push(`${knot}@${s.tag} (${s.ropelength.toFixed(2)}, ${s.vertices} vertices, residual ${s.residual.toFixed(2)})`);
+        const judged = converged.length ? converged : ok;
+        const best = judged.reduce((a, b) => (b.ropelength < a.ropelength ? b : a));
+        const worst = judged.reduce((a, b) => (b.ropelength > a.ropelength ? b : a));
         const spread = 100 * (worst.ropelength - best.ropelength) / best.ropelength;
-        const cat = ok.find((s) => s.tag === 'cat');
+        const cat = converged.find((s) => s.tag === 'cat');
         const catAbove = cat ? 100 * (cat.ropelength - best.ropelength) / best.ropelength : NaN;
         let type = '', want = null;
         try {
@@ -296,10 +313,11 @@ function writeTable() {
             best.tag, spread.toFixed(4), Number.isFinite(catAbove) ? catAbove.toFixed(4) : '',
             best.reached, best.struts, kinksOf(`${knot}@${best.tag}`, best.dir),
             ok.reduce((t, s) => t + s.seconds, 0).toFixed(0), failed.length,
-            want ? changed.join(' ') || 'none' : '', settings].join('\t'));
+            want ? changed.join(' ') || 'none' : '', unconverged.map((s) => s.tag).join(' '),
+            settings].join('\t'));
         summary.knots++;
-        if (ok.length > 1) summary.compared++;
-        if (ok.length > 1 && spread <= 0.1) summary.agree++;
+        if (converged.length > 1) summary.compared++;
+        if (converged.length > 1 && spread <= 0.1) summary.agree++;
         summary.spreads.push([spread, knot, best.tag, best.ropelength, worst.tag, worst.ropelength]);
         if (catAbove > 0.1) summary.catTrapped.push([catAbove, knot]);
     }
@@ -307,8 +325,10 @@ function writeTable() {
     writeFileSync(opt.table, lines.join('\n') + '\n');
     const pct = (n) => (summary.knots ? (100 * n / summary.knots).toFixed(1) : '-');
     console.log(`table: ${opt.table}, ${summary.knots} of ${knots.length} knots and links (${settings})`);
-    console.log(`  with two starts or more: ${summary.compared}; every start within 0.1% of the lowest: ` +
-        `${summary.agree} (${summary.compared ? (100 * summary.agree / summary.compared).toFixed(1) : '-'}%)`);
+    console.log(`  with two converged starts or more: ${summary.compared}; every converged start within ` +
+        `0.1% of the lowest: ${summary.agree} (${summary.compared ? (100 * summary.agree / summary.compared).toFixed(1) : '-'}%)`);
+    console.log(`  starts still moving when their time ran out (residual >= ${CONVERGED}): ` +
+        `${summary.unconverged.length}` + (summary.unconverged.length ? `: ${summary.unconverged.join('; ')}` : ''));
     console.log(`  the catalogue's start more than 0.1% above the lowest: ${summary.catTrapped.length} ` +
         `(${pct(summary.catTrapped.length)}%)` + (summary.catTrapped.length
         ? `, by ${Math.min(...summary.catTrapped.map((t) => t[0])).toFixed(2)}% to ` +

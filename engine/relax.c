@@ -7,6 +7,7 @@
 
 #include "tk/geometry.h"
 #include "rng.h"
+#include "tk/generate.h"
 #include "tk/invariants.h"
 
 /* The springs' weight against the repulsion: at 1 the repulsion pulls
@@ -29,6 +30,11 @@
 #define TURN_CLEARANCE 1e-3
 #define TURN_OFFSET 0.15
 #define TURN_DOUBLINGS 3
+/* Wandering: the target is the curve displaced by WANDER_MODES Fourier
+ * modes of amplitude its components' mean radius (L / 2 pi), the pull's
+ * weight WANDER_PULL. */
+#define WANDER_MODES 3
+#define WANDER_PULL 1.0
 
 double tk_relax_energy(const tk_curve *c, const tk_curve *target, double pull, double *grad)
 {
@@ -297,4 +303,30 @@ void tk_relax_turn_offset(uint64_t *state, double offset[3])
 {
     for (int k = 0; k < 3; k++)
         offset[k] = TURN_OFFSET * tk_rng_normal(state);
+}
+
+int tk_relax_wander(const tk_curve *c, uint64_t seed, int steps, tk_curve **out, tk_error *err)
+{
+    *out = NULL;
+    tk_curve *target = NULL, *pulled = NULL;
+    size_t ncoef = c->ncomp * WANDER_MODES * 6;
+    double *coef = malloc(ncoef * sizeof *coef);
+    int rc = coef ? tk_curve_copy(c, &target, err) : tk_error_set(err, TK_ENOMEM, "out of memory");
+    double radius = 0.0;
+    for (size_t comp = 0; !rc && comp < c->ncomp; comp++)
+        radius += tk_curve_comp_length(c, comp) / (2.0 * M_PI) / (double)c->ncomp;
+    for (size_t i = 0; !rc && i < ncoef; i++)
+        coef[i] = tk_rng_normal(&seed);
+    if (!rc)
+        tk_generate_fourier(target, c, coef, WANDER_MODES, radius);
+    /* toward the target as far as the strands let it, then relaxed at the
+     * length reached: both steps move no edge through another */
+    if (!rc)
+        rc = tk_relax(c, target, WANDER_PULL, steps, &pulled, NULL, err);
+    if (!rc)
+        rc = tk_relax(pulled, NULL, 0.0, steps, out, NULL, err);
+    free(coef);
+    tk_curve_free(&target);
+    tk_curve_free(&pulled);
+    return rc;
 }

@@ -262,6 +262,30 @@ START_TEST(turning_keeps_type_and_hand)
 }
 END_TEST
 
+/* Wandering: the type kept, the shape far from the start (some vertex
+ * moved by more than the curve's radius), the same seed the same curve. */
+START_TEST(wandering_goes_far_and_keeps_the_type)
+{
+    tk_curve *link = uneven_link(), *out = NULL, *again = NULL;
+    ck_assert_int_eq(tk_relax_wander(link, 7, 400, &out, NULL), TK_OK);
+    check_kept(link, out);
+    double radius = tk_curve_length(link) / (2.0 * M_PI * (double)link->ncomp), moved = 0.0;
+    for (size_t v = 0; v < link->nvert; v++) {
+        double d = 0.0;
+        for (int k = 0; k < 3; k++)
+            d += pow(out->xyz[3 * v + k] - link->xyz[3 * v + k], 2);
+        moved = fmax(moved, sqrt(d));
+    }
+    printf("wandered: the farthest vertex moved %.3g, the radius %.3g\n", moved, radius);
+    ck_assert(moved > radius);
+    ck_assert_int_eq(tk_relax_wander(link, 7, 400, &again, NULL), TK_OK);
+    ck_assert_mem_eq(again->xyz, out->xyz, 3 * out->nvert * sizeof *out->xyz);
+    tk_curve_free(&link);
+    tk_curve_free(&out);
+    tk_curve_free(&again);
+}
+END_TEST
+
 START_TEST(invalid_arguments)
 {
     tk_curve *c = tkt_regular_polygon(12, 1.0), *other = tkt_regular_polygon(13, 1.0);
@@ -290,6 +314,7 @@ int main(void)
     tcase_add_test(tc, a_pull_cannot_change_the_type);
     tcase_add_test(tc, a_round_circle_stays);
     tcase_add_test(tc, turning_keeps_type_and_hand);
+    tcase_add_test(tc, wandering_goes_far_and_keeps_the_type);
     tcase_add_test(tc, invalid_arguments);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);

@@ -4,7 +4,7 @@
  *   tightknot struts [--json] [--tolerance EPS] FILE
  *   tightknot generate torus P Q | figure-eight | lissajous NX NY NZ | hopf | borromean | chain K
  *                      | deform FILE [SEED] | relax FILE [STEPS]
- *                      | turn FILE [SEED]
+ *                      | turn FILE [SEED] | wander FILE [SEED]
  *                      [--vertices N] [--disguise SEED]
  *   tightknot tighten FILE [run options] [-o OUT] [--struts OUT] [--log OUT]
  *                    [--snapshots DIR --every K] [--json]
@@ -71,7 +71,7 @@ static const char main_help[] =
     "  generate   write a knot or link as VECT on standard output: an example\n"
     "             (torus P Q, figure-eight, lissajous NX NY NZ, hopf,\n"
     "             borromean, chain K) or a start of another shape with a\n"
-    "             file's type (deform FILE, relax FILE, turn FILE)\n"
+    "             file's type (deform FILE, relax FILE, turn FILE, wander FILE)\n"
     "  tighten    tighten a knot or link: shorten it keeping the tube embedded\n"
     "  remote     use a tightknot service: submit files, list, status, cancel,\n"
     "             delete and fetch jobs\n"
@@ -211,6 +211,12 @@ static const char generate_help[] =
     "              what wound around the centre then winds around the curve\n"
     "              (a torus knot's T(p,q) form becomes its T(q,p) form), the\n"
     "              type kept; --vertices N in all (default FILE's count)\n"
+    "  wander FILE [SEED]\n"
+    "              FILE's curve drawn toward a far random shape (three Fourier\n"
+    "              modes as large as the curve, from SEED, default 1) as far\n"
+    "              as its strands let it, then relaxed: every step too short\n"
+    "              for an edge to pass through another, so the type is kept\n"
+    "              exactly, links of unknots included (closed components)\n"
     "  chain K     K >= 1 rings of radius 1, centres 1.5 apart on the x axis,\n"
     "              in alternating planes, each linked with its neighbours\n"
     "\n"
@@ -758,6 +764,8 @@ static int cmd_struts(int argc, char **argv)
 /* generate turn: relaxation steps after the turn, as the escapes'
  * turned tries take (engine/escape.c) */
 #define TURN_STEPS 3000
+/* generate wander: steps of the pull, and as many of relaxing */
+#define WANDER_STEPS 2000
 
 /* Builds the curve a generate command line asks for; EXIT_USAGE with a
  * message when the shape or its arguments are wrong. */
@@ -766,7 +774,7 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
     const char *cmd = "generate";
     if (npos == 0)
         return usage_error(cmd, "no SHAPE given (torus P Q, figure-eight, lissajous NX NY NZ, "
-                                "hopf, borromean, chain K, deform FILE, relax FILE or turn FILE)");
+                                "hopf, borromean, chain K, deform FILE, relax FILE, turn FILE or wander FILE)");
     const char *shape = pos[0];
     tk_error err;
     tk_error_clear(&err);
@@ -834,6 +842,22 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
             report(NULL, &err);
             return EXIT_INPUT;
         }
+    } else if (strcmp(shape, "wander") == 0) {
+        if (npos != 2 && npos != 3)
+            return usage_error(cmd, "wander takes a FILE and optionally a SEED");
+        long long seed = 1;
+        if (npos == 3 && parse_integer(cmd, "wander SEED", pos[2], 0, 1LL << 53, &seed))
+            return EXIT_USAGE;
+        tk_curve *src = NULL;
+        char path[PATH_MAX];
+        rc = tk_vect_read_file(input_path(pos[1], path), NULL, &src, &err);
+        if (!rc)
+            rc = tk_relax_wander(src, (uint64_t)seed, WANDER_STEPS, out, &err);
+        tk_curve_free(&src);
+        if (rc == TK_EPARSE || rc == TK_EIO) {
+            report(NULL, &err);
+            return EXIT_INPUT;
+        }
     } else if (strcmp(shape, "turn") == 0) {
         if (npos != 2 && npos != 3)
             return usage_error(cmd, "turn takes a FILE and optionally a SEED");
@@ -866,7 +890,7 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
     } else {
         return usage_error(cmd,
                            "unknown shape '%s' (torus P Q, figure-eight, lissajous NX NY NZ, "
-                           "hopf, borromean, chain K, deform FILE, relax FILE or turn FILE)",
+                           "hopf, borromean, chain K, deform FILE, relax FILE, turn FILE or wander FILE)",
                            shape);
     }
     if (rc == TK_EINVAL || rc == TK_ELIMIT)

@@ -80,4 +80,14 @@ int tk_relax_turn(const tk_curve *c, const double offset[3], size_t vertices, in
  * near the centroid, where the curve winds around. */
 void tk_relax_turn_offset(uint64_t *state, double offset[3]);
 
+/* A start of another shape with c's type, guaranteed: c drawn by a pull
+ * (tk_relax, `steps` steps) toward a far target (c displaced by a smooth
+ * random field, three Fourier modes of amplitude its components' mean
+ * radius, drawn from `seed`), then relaxed for `steps` more at the length
+ * it reached.  Unlike a displacement applied at once (tk_generate_deform,
+ * which checks the type with invariants that cannot tell every link of
+ * unknots apart), no edge passes through another on the way: the type is
+ * kept whatever the invariants can see.  Closed components only. */
+int tk_relax_wander(const tk_curve *c, uint64_t seed, int steps, tk_curve **out, tk_error *err);
+
 #endif
