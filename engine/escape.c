@@ -314,10 +314,8 @@ static int try_curve(tk_run *r, const tk_curve *best, double thickness, double r
     if (count < 8 * best->ncomp)
         count = 8 * best->ncomp;
     *amplitude = 0.0;
-    double t0 = tk_clock();
     tk_error why;
     int rc = tk_relax_turn(best, offset, count, TURN_STEPS, out, &why);
-    r->escape.type_seconds += tk_clock() - t0;
     if (rc == TK_ENOMEM)
         return tk_error_set(err, rc, "%s", why.message);
     /* a centre too near the curve, or too few vertices to turn it: a far

@@ -36,6 +36,17 @@
 #define WANDER_MODES 3
 #define WANDER_PULL 1.0
 
+/* Whether edges a and b share no vertex (the pairs E and the gap are
+ * over), and then their closest points. */
+static bool apart(const tk_curve *c, tk_edge a, tk_edge b, tk_closest *cl)
+{
+    if (a.head == b.head || a.head == b.tail || a.tail == b.head || a.tail == b.tail)
+        return false;
+    tk_segment_closest(tk_curve_vertex(c, a.head), tk_curve_vertex(c, a.tail),
+                       tk_curve_vertex(c, b.head), tk_curve_vertex(c, b.tail), cl);
+    return true;
+}
+
 double tk_relax_energy(const tk_curve *c, const tk_curve *target, double pull, double *grad)
 {
     size_t m = tk_curve_edge_count(c);
@@ -47,11 +58,9 @@ double tk_relax_energy(const tk_curve *c, const tk_curve *target, double pull, d
         tk_edge a = tk_curve_edge(c, i);
         for (size_t j = i + 1; j < m; j++) {
             tk_edge b = tk_curve_edge(c, j);
-            if (a.head == b.head || a.head == b.tail || a.tail == b.head || a.tail == b.tail)
-                continue;
             tk_closest cl;
-            tk_segment_closest(tk_curve_vertex(c, a.head), tk_curve_vertex(c, a.tail),
-                               tk_curve_vertex(c, b.head), tk_curve_vertex(c, b.tail), &cl);
+            if (!apart(c, a, b, &cl))
+                continue;
             double r2 = cl.dist * cl.dist;
             repulsion += h2 / r2;
             if (!grad)
@@ -113,13 +122,9 @@ double tk_relax_gap(const tk_curve *c)
     for (size_t i = 0; i < m; i++) {
         tk_edge a = tk_curve_edge(c, i);
         for (size_t j = i + 1; j < m; j++) {
-            tk_edge b = tk_curve_edge(c, j);
-            if (a.head == b.head || a.head == b.tail || a.tail == b.head || a.tail == b.tail)
-                continue;
             tk_closest cl;
-            tk_segment_closest(tk_curve_vertex(c, a.head), tk_curve_vertex(c, a.tail),
-                               tk_curve_vertex(c, b.head), tk_curve_vertex(c, b.tail), &cl);
-            gap = fmin(gap, cl.dist);
+            if (apart(c, a, tk_curve_edge(c, j), &cl))
+                gap = fmin(gap, cl.dist);
         }
     }
     return gap;

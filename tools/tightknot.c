@@ -767,6 +767,61 @@ static int cmd_struts(int argc, char **argv)
 /* generate wander: steps of the pull, and as many of relaxing */
 #define WANDER_STEPS 2000
 
+/* The shapes made from a FILE's curve, each with its optional number
+ * (a seed, or steps) and the call that makes it. */
+static int make_deform(const tk_curve *src, long long seed, size_t vertices, tk_curve **out,
+                       tk_error *err)
+{
+    (void)vertices;
+    return tk_generate_deform(src, (unsigned long long)seed, DEFORM_KEEP, out, err);
+}
+
+static int make_relax(const tk_curve *src, long long steps, size_t vertices, tk_curve **out,
+                      tk_error *err)
+{
+    (void)vertices;
+    return tk_relax(src, NULL, 0.0, (int)steps, out, NULL, err);
+}
+
+static int make_wander(const tk_curve *src, long long seed, size_t vertices, tk_curve **out,
+                       tk_error *err)
+{
+    (void)vertices;
+    return tk_relax_wander(src, (uint64_t)seed, WANDER_STEPS, out, err);
+}
+
+static int make_turn(const tk_curve *src, long long seed, size_t vertices, tk_curve **out,
+                     tk_error *err)
+{
+    double offset[3] = {0.0, 0.0, 0.0};
+    uint64_t state = (uint64_t)seed;
+    if (seed > 0)
+        tk_relax_turn_offset(&state, offset);
+    return tk_relax_turn(src, offset, vertices ? vertices : src->nvert, TURN_STEPS, out, err);
+}
+
+typedef struct from_file_shape {
+    const char *name, *arg;
+    long long dflt, lo, hi;
+    int (*make)(const tk_curve *src, long long n, size_t vertices, tk_curve **out,
+                tk_error *err);
+} from_file_shape;
+
+static const from_file_shape from_file_shapes[] = {
+    {"deform", "SEED", 1, 0, 1LL << 53, make_deform},
+    {"relax", "STEPS", 2000, 1, INT_MAX, make_relax},
+    {"turn", "SEED", 0, 0, 1LL << 53, make_turn},
+    {"wander", "SEED", 1, 0, 1LL << 53, make_wander},
+};
+
+static const from_file_shape *from_file(const char *shape)
+{
+    for (size_t i = 0; i < sizeof from_file_shapes / sizeof from_file_shapes[0]; i++)
+        if (!strcmp(shape, from_file_shapes[i].name))
+            return &from_file_shapes[i];
+    return NULL;
+}
+
 /* Builds the curve a generate command line asks for; EXIT_USAGE with a
  * message when the shape or its arguments are wrong. */
 static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
@@ -810,71 +865,20 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
             freq[k] = (int)f;
         }
         rc = tk_generate_lissajous(freq, phase, vertices, out, &err);
-    } else if (strcmp(shape, "deform") == 0) {
+    } else if (from_file(shape)) {
+        const from_file_shape *f = from_file(shape);
         if (npos != 2 && npos != 3)
-            return usage_error(cmd, "deform takes a FILE and optionally a SEED");
-        long long seed = 1;
-        if (npos == 3 && parse_integer(cmd, "deform SEED", pos[2], 0, 1LL << 53, &seed))
+            return usage_error(cmd, "%s takes a FILE and optionally %s", shape, f->arg);
+        long long n = f->dflt;
+        char what[32];
+        snprintf(what, sizeof what, "%s %s", shape, f->arg);
+        if (npos == 3 && parse_integer(cmd, what, pos[2], f->lo, f->hi, &n))
             return EXIT_USAGE;
         tk_curve *src = NULL;
         char path[PATH_MAX];
         rc = tk_vect_read_file(input_path(pos[1], path), NULL, &src, &err);
         if (!rc)
-            rc = tk_generate_deform(src, (unsigned long long)seed, DEFORM_KEEP, out, &err);
-        tk_curve_free(&src);
-        if (rc == TK_EPARSE || rc == TK_EIO) {
-            report(NULL, &err);
-            return EXIT_INPUT;
-        }
-    } else if (strcmp(shape, "relax") == 0) {
-        if (npos != 2 && npos != 3)
-            return usage_error(cmd, "relax takes a FILE and optionally a number of STEPS");
-        long long steps = 2000;
-        if (npos == 3 && parse_integer(cmd, "relax STEPS", pos[2], 1, INT_MAX, &steps))
-            return EXIT_USAGE;
-        tk_curve *src = NULL;
-        char path[PATH_MAX];
-        rc = tk_vect_read_file(input_path(pos[1], path), NULL, &src, &err);
-        if (!rc)
-            rc = tk_relax(src, NULL, 0.0, (int)steps, out, NULL, &err);
-        tk_curve_free(&src);
-        if (rc == TK_EPARSE || rc == TK_EIO) {
-            report(NULL, &err);
-            return EXIT_INPUT;
-        }
-    } else if (strcmp(shape, "wander") == 0) {
-        if (npos != 2 && npos != 3)
-            return usage_error(cmd, "wander takes a FILE and optionally a SEED");
-        long long seed = 1;
-        if (npos == 3 && parse_integer(cmd, "wander SEED", pos[2], 0, 1LL << 53, &seed))
-            return EXIT_USAGE;
-        tk_curve *src = NULL;
-        char path[PATH_MAX];
-        rc = tk_vect_read_file(input_path(pos[1], path), NULL, &src, &err);
-        if (!rc)
-            rc = tk_relax_wander(src, (uint64_t)seed, WANDER_STEPS, out, &err);
-        tk_curve_free(&src);
-        if (rc == TK_EPARSE || rc == TK_EIO) {
-            report(NULL, &err);
-            return EXIT_INPUT;
-        }
-    } else if (strcmp(shape, "turn") == 0) {
-        if (npos != 2 && npos != 3)
-            return usage_error(cmd, "turn takes a FILE and optionally a SEED");
-        long long seed = 0;
-        if (npos == 3 && parse_integer(cmd, "turn SEED", pos[2], 0, 1LL << 53, &seed))
-            return EXIT_USAGE;
-        tk_curve *src = NULL;
-        char path[PATH_MAX];
-        rc = tk_vect_read_file(input_path(pos[1], path), NULL, &src, &err);
-        if (!rc) {
-            double offset[3] = {0.0, 0.0, 0.0};
-            uint64_t state = (uint64_t)seed;
-            if (seed > 0)
-                tk_relax_turn_offset(&state, offset);
-            rc = tk_relax_turn(src, offset, vertices ? vertices : src->nvert, TURN_STEPS, out,
-                               &err);
-        }
+            rc = f->make(src, n, vertices, out, &err);
         tk_curve_free(&src);
         if (rc == TK_EPARSE || rc == TK_EIO) {
             report(NULL, &err);

@@ -5,11 +5,12 @@
  * basin its start lies in.  A start's shape (the projection it was drawn
  * from, a crossing pushed to one side) can hold it in a basin above the
  * knot's lowest.  A repulsive energy, minimised at fixed length, spreads
- * every strand away from every other and smooths the curve out: the
- * strands' arrangement is kept (the type cannot change, below) but the
- * start's accidents are lost, and what remains is a shape of the type
- * itself, often a symmetric one (a torus knot relaxes toward its torus
- * form).  Its tightening explores another basin than the start's.
+ * every strand away from every other and smooths the curve out, keeping
+ * the strands' arrangement (the type cannot change, below).  Relaxing
+ * alone does not leave the start's basin (catalogue 10.124 relaxed
+ * tightened to where the file does, 71.127); the moves below that change
+ * the arrangement's shape by isotopy, turning inside out and wandering,
+ * use it to even out what they make.
  *
  * The energy (of the vertices x_i, h the mean edge length):
  *     E = sum over pairs of edges of h^2 / r^2
