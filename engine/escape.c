@@ -298,7 +298,8 @@ enum { TRY_NEAR, TRY_TURNED, TRY_FAR, TRY_KINDS };
  * catalogue 10.124 turned about its centroid tightened to 71.0024 in 60 s
  * (resolution 5); runs whose turns were all about points drawn near it
  * ended at 71.054 and 71.058 (seeds 1 and 2, 120 s), and with the first
- * about the centroid at 71.0546 and 71.0028. */
+ * about the centroid at 71.00266 and 71.00279 (each through a turned try
+ * on the final polygon, from 71.058). */
 static int try_curve(tk_run *r, const tk_curve *best, double thickness, double rope, int index,
                      tk_curve **out, double *amplitude, bool *turned, tk_error *err)
 {
