@@ -295,8 +295,9 @@ enum { TRY_NEAR, TRY_TURNED, TRY_FAR, TRY_KINDS };
  * the given thickness and ropelength) into *out; *turned says whether it
  * was turned.  The first turn is about the centroid itself, the later
  * ones about points drawn near it (the stream draws the same either way):
- * catalogue 10.124 turned about its centroid tightened to 71.0024 in 60 s
- * (resolution 5); runs whose turns were all about points drawn near it
+ * catalogue 10.124 turned about its centroid tightened to 71.0024 and
+ * 71.0012 in 60 s (resolution 5, two runs of bench/catalogue); runs
+ * whose turns were all about points drawn near it
  * ended at 71.054 and 71.058 (seeds 1 and 2, 120 s), and with the first
  * about the centroid at 71.00266 and 71.00279 (each through a turned try
  * on the final polygon, from 71.058). */
