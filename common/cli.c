@@ -128,7 +128,17 @@ int tk_cli_parse(tk_cli *c, int argc, char **argv, int *npos, tk_error *err)
         assert(k < c->n); /* getopt returns only the letters it was given */
         if (apply(&c->opt[k], optarg, err))
             return TK_EINVAL;
+        c->opt[k].given = true;
     }
+}
+
+bool tk_cli_given(const tk_cli *c, const void *record, const char *name)
+{
+    for (size_t k = 0; k < c->n; k++)
+        if (c->opt[k].given && c->opt[k].record == record && c->opt[k].field &&
+            c->opt[k].field->name && !strcmp(c->opt[k].field->name, name))
+            return true;
+    return false;
 }
 
 void tk_cli_help(const tk_cli *c, FILE *out)

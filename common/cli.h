@@ -29,6 +29,7 @@ typedef struct tk_cli_option {
     const tk_field *field; /* a field of `record`, set with its domain */
     void *record;
     bool negated;          /* the --no-NAME of a BOOL field */
+    bool given;            /* set by tk_cli_parse when it was on the line */
 } tk_cli_option;
 
 typedef struct tk_cli {
@@ -54,6 +55,10 @@ void tk_cli_defaults(const tk_field *table, size_t n, void *record);
  * them.  TK_EINVAL with a message naming the option when one is unknown,
  * lacks its value or has a value outside its domain. */
 int tk_cli_parse(tk_cli *c, int argc, char **argv, int *npos, tk_error *err);
+
+/* Whether an option of the field `name` of `record` was on the line (its
+ * --no- form too). */
+bool tk_cli_given(const tk_cli *c, const void *record, const char *name);
 
 /* The options with their help, one per line, the help wrapped at 78
  * columns; a field's help ends with its default. */

@@ -18,7 +18,10 @@ int tk_job_option_set_text(tk_job_options *o, const char *name, const char *text
     const tk_field *f = tk_field_find(tk_job_option_fields, tk_job_option_nfields, name);
     if (!f)
         return tk_error_set(err, TK_EINVAL, "unknown option '%.60s'", name);
-    return tk_field_parse(f, o, text, err);
+    int rc = tk_field_parse(f, o, text, err);
+    if (!rc)
+        (void)tk_options_given_mark(&o->given, name); /* false for every */
+    return rc;
 }
 
 int tk_job_options_from_json(tk_job_options *o, const json_t *obj, const char **bad,
@@ -28,11 +31,17 @@ int tk_job_options_from_json(tk_job_options *o, const json_t *obj, const char **
         *bad = NULL;
     if (!json_is_object(obj))
         return tk_error_set(err, TK_EINVAL, "'options' must be a JSON object");
-    return tk_json_record_set(tk_job_option_fields, tk_job_option_nfields, o, obj, bad, err);
+    int rc = tk_json_record_set(tk_job_option_fields, tk_job_option_nfields, o, obj, bad, err);
+    const char *name;
+    json_t *value;
+    json_object_foreach((json_t *)obj, name, value) {
+        if (!rc)
+            (void)tk_options_given_mark(&o->given, name); /* false for every */
+    }
+    return rc;
 }
 
 void tk_job_options_complete(tk_job_options *o)
 {
-    if (!tk_options_have_stop(&o->run))
-        o->run.max_steps = TK_DEFAULT_STEPS;
+    tk_options_complete(&o->run, &o->given);
 }

@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -125,5 +126,47 @@ int tk_options_check(const tk_options *o, tk_error *err)
 bool tk_options_have_stop(const tk_options *o)
 {
     return o->max_steps > 0 || o->max_seconds > 0.0 || o->min_residual > 0.0 ||
-           o->min_change > 0.0;
+           o->min_change > 0.0 || o->converge;
+}
+
+double tk_options_spent(const tk_options *o, const tk_step_report *s)
+{
+    double spent = -1.0;
+    if (o->max_steps > 0)
+        spent = (double)s->step / (double)o->max_steps;
+    if (o->max_seconds > 0.0)
+        spent = fmax(spent, s->seconds / o->max_seconds);
+    return spent;
+}
+
+/* Where each run option's mark lies in tk_options_given, by its name
+ * (NULL: the engine's own, not given by users). */
+#define GIVEN_ROW(fld, kind, dflt, lo, hi, nm, hlp) {nm, offsetof(tk_options_given, fld)},
+static const struct {
+    const char *name;
+    size_t offset;
+} given_rows[] = {TK_OPTION_FIELDS(GIVEN_ROW)};
+
+bool tk_options_given_mark(tk_options_given *g, const char *name)
+{
+    for (size_t i = 0; i < sizeof given_rows / sizeof given_rows[0]; i++)
+        if (given_rows[i].name && !strcmp(given_rows[i].name, name)) {
+            *(bool *)((char *)g + given_rows[i].offset) = true;
+            return true;
+        }
+    return false;
+}
+
+void tk_options_complete(tk_options *o, const tk_options_given *given)
+{
+    if (o->max_steps > 0 || o->min_residual > 0.0 || o->min_change > 0.0)
+        return;
+    if (!given->resolution && !given->vertices)
+        o->resolution = TK_DEFAULT_RESOLUTION;
+    if (!given->autoscale)
+        o->autoscale = true;
+    if (!given->converge)
+        o->converge = !(given->max_seconds && o->max_seconds > 0.0);
+    if (!given->max_seconds)
+        o->max_seconds = TK_DEFAULT_SECONDS;
 }

@@ -238,6 +238,7 @@ struct tk_run {
         long *snapshot_steps;
         size_t nsnapshots, snapshot_capacity;
         double started;
+        double flow_from; /* the flow's time at the start (a resumed run's) */
         tk_stop_reason stop;
         atomic_int cancel;
         tk_progress_fn progress;
@@ -473,6 +474,9 @@ bool tk_schedule_move_on(tk_run *r);
  * spent. */
 bool tk_schedule_share_spent(const tk_run *r);
 size_t tk_schedule_final_count(const tk_run *r);
+/* Whether the run has gone as far as its tolerances allow: on the final
+ * polygon, at its last polishing level, and stopped falling there. */
+bool tk_schedule_settled(const tk_run *r);
 /* A window of `steps` steps at resolution 5, counted for the run's
  * polygon: as many more steps as its mean edge is shorter. */
 size_t tk_schedule_window(const tk_run *r, size_t steps);

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 
 #include "run.h"
+#include "tk/record.h"
 #include "tk/thickness.h"
 
 /* Each time the ropelength falls by less than POLISH_CHANGE (relative;
@@ -473,13 +474,7 @@ double tk_schedule_spent(const tk_run *r)
 
 double tk_schedule_spent_at(const tk_run *r, const tk_step_report *s)
 {
-    const tk_options *o = &r->opt;
-    double spent = 0.0;
-    if (o->max_steps > 0)
-        spent = fmax(spent, (double)s->step / (double)o->max_steps);
-    if (o->max_seconds > 0.0)
-        spent = fmax(spent, s->seconds / o->max_seconds);
-    return spent;
+    return fmax(0.0, tk_options_spent(&r->opt, s));
 }
 
 bool tk_schedule_share_spent(const tk_run *r)
@@ -674,6 +669,12 @@ static bool stalled(const tk_run *r)
     return tk_schedule_final(r) && window >= POLISH_RATE_FROM * POLISH_WINDOW &&
            tk_history_fall(r, from, POLISH_WINDOW, &fall) &&
            fall * (double)window / POLISH_WINDOW < bound;
+}
+
+bool tk_schedule_settled(const tk_run *r)
+{
+    return tk_schedule_final(r) && r->schedule.polish_level >= polish_levels(r) &&
+           (stalled(r) || critical_since(r, r->schedule.polish_from));
 }
 
 /* Judged on the history before this step's figures, after its motion and

@@ -20,6 +20,7 @@ const char *tk_stop_reason_name(tk_stop_reason r)
     case TK_STOP_CANCELLED: return "cancelled";
     case TK_STOP_STALLED: return "stalled";
     case TK_STOP_FAILED: return "failed";
+    case TK_STOP_CONVERGED: return "converged";
     }
     return "unknown";
 }
@@ -61,6 +62,9 @@ static int record(tk_run *r, tk_step_report *rep, tk_error *err)
     rep->escapes = tk_escape_tries(r);
     rep->restarts = r->schedule.restarts;
     rep->seconds = tk_clock() - r->life.started;
+    /* a step put back (record_restored) has size 0 and keeps its time */
+    rep->flow_time = (r->life.nhistory > 0 ? r->life.latest.flow_time : r->life.flow_from) +
+                     rep->step_size;
     if (r->life.nhistory == r->life.history_capacity) {
         size_t cap = r->life.history_capacity ? 2 * r->life.history_capacity : 256;
         tk_step_report *grown = realloc(r->life.history, cap * sizeof *grown);
@@ -137,6 +141,7 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
     atomic_init(&r->life.cancel, 0);
     /* a resumed run's clock goes on from the time it had spent */
     r->life.started = tk_clock() - (at ? at->seconds : 0.0);
+    r->life.flow_from = at ? at->flow_time : 0.0;
     tk_escape_start(r, at != NULL);
     rc = tk_nnls_new(&r->shared.nnls, err);
     if (!rc)
@@ -196,6 +201,7 @@ void tk_run_resume_point(const tk_run *r, tk_resume *out)
     out->step = r->life.latest.step;
     out->seconds = r->life.latest.seconds;
     out->step_size = r->stepping.step_size;
+    out->flow_time = r->life.latest.flow_time;
     tk_schedule_resume_point(r, out);
     tk_escape_resume_point(r, out);
 }
@@ -212,7 +218,8 @@ void tk_run_cancel(tk_run *r)
 }
 
 /* The first criterion met, in the order cancellation, budget,
- * convergence (a run's stop so far stands when none is).  A stall on the
+ * convergence (a run's stop so far stands when none is); converge's
+ * stop only once the escapes ask for no more.  A stall on the
  * final polygon stops the run; on a coarse one it moves the schedule on,
  * as a spent share of the budget does. */
 static void check_stop(tk_run *r)
@@ -244,6 +251,8 @@ static void check_stop(tk_run *r)
                      (stop == TK_STOP_NONE && tk_escape_converged(r));
     if (converged && tk_escape_ask(r))
         stop = TK_STOP_NONE;
+    else if (converged && stop == TK_STOP_NONE && o->converge && tk_schedule_settled(r))
+        stop = TK_STOP_CONVERGED; /* no try left, nor a best to put back */
     else if (stop == TK_STOP_NONE)
         tk_escape_reserve(r);
     if (tk_schedule_share_spent(r)) {

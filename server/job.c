@@ -61,11 +61,7 @@ void tk_job_set_figures(json_t *doc, const tk_step_report *r, const tk_job_optio
         json_object_set_new(doc, "residual", json_null());
         json_object_set_new(doc, "step_size", json_null());
     }
-    double f = -1.0;
-    if (o->run.max_steps > 0)
-        f = (double)r->step / (double)o->run.max_steps;
-    if (o->run.max_seconds > 0.0)
-        f = fmax(f, r->seconds / o->run.max_seconds);
+    double f = tk_options_spent(&o->run, r);
     json_object_set_new(doc, "progress",
                         json_pack("{s:I, s:o}", "step", (json_int_t)r->step, "fraction",
                                   f < 0.0 ? json_null() : json_real(fmin(f, 1.0))));

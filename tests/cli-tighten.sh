@@ -105,9 +105,12 @@ check $? "--json's undone_steps and rescales ($given) are the summary's ${said:-
 "$tk" tighten "$tmp/trefoil.vect" --autoscale --resolution 5 --steps 3500 --json \
     --log "$tmp/reserve.tsv" >"$tmp/reserve.json" 2>"$tmp/err"
 check $? "tighten --steps 3500 with escapes exits 0: $(cat "$tmp/err")"
-# the put-back: restarts (column 16) up by one, vertices (14) from fewer
-# than the final count to it; then the rows after it off the final count
-awk -F'\t' 'NR > 1 { v[NR] = $14; r[NR] = $16; p[NR] = $3; if ($14 > final) final = $14; n = NR }
+# the put-back: restarts up by one, vertices from fewer than the final
+# count to it; then the rows after it off the final count (the columns by
+# the log's header)
+awk -F'\t' 'NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
+    { v[NR] = $col["vertices"]; r[NR] = $col["restarts"]; p[NR] = $col["ropelength"]
+      if (v[NR] > final) final = v[NR]; n = NR }
     END { for (i = 3; i <= n; i++)
               if (!at && r[i] == r[i - 1] + 1 && v[i - 1] < final && v[i] == final) at = i
           for (i = at + 1; at && i <= n; i++) off += v[i] != final
@@ -159,7 +162,7 @@ check $? "a run that changes the type: exit $status, $(cat "$tmp/err")"
 
 # bad options: exit 1, named
 for args in "--radius 0" "--lambda -1" "--steps 2.5" "--resolution -1" "--time abc" \
-    "--residual nan" "--overstep 0.5" "--every 0" "--re-resolve 1" "--re-resolve 0.1" \
+    "--residual nan" "--overstep 0.5" "--every 0" "--re-resolve 1" "--re-resolve 0.1 --steps 9" \
     "--escapes -1" "--escapes 1001" "--seed x" "--frobnicate 1"; do
     # shellcheck disable=SC2086
     "$tk" tighten "$tmp/trefoil.vect" $args >/dev/null 2>"$tmp/err"
@@ -173,11 +176,28 @@ printf 'VECT\n1 3 0\n-3\n0\n0 0 0\n1 0 0\n0 q 0\n' >"$tmp/bad.vect"
 "$tk" tighten "$tmp/bad.vect" >/dev/null 2>"$tmp/err"
 [ $? -eq 2 ] && grep -q "bad.vect:7: expected coordinate y" "$tmp/err"
 check $? "a malformed file: $(cat "$tmp/err")"
-# a start thinner than the tube without --autoscale: exit 2, said why
+# a start thinner than the tube with every option as given (--steps)
+# and without --autoscale: exit 2, said why
 "$tk" generate torus 2 3 --vertices 90 >"$tmp/thin.vect"
-"$tk" tighten "$tmp/thin.vect" --radius 50 >/dev/null 2>"$tmp/err"
+"$tk" tighten "$tmp/thin.vect" --radius 50 --steps 10 >/dev/null 2>"$tmp/err"
 [ $? -eq 2 ] && grep -qi "thick\|diameter" "$tmp/err"
 check $? "a start thinner than the tube: $(cat "$tmp/err")"
+# the defaults that tighten: a Hopf link far thinner than the tube, no
+# option but the radius, ends converged within 0.1% of the exact 8 pi
+# (the polygon's own error at resolution 5 is about 0.08%), with the
+# options it ran with shown
+"$tk" generate chain 2 --vertices 40 >"$tmp/hopf-default.vect"
+"$tk" tighten "$tmp/hopf-default.vect" --radius 50 --json >"$tmp/default.json" 2>"$tmp/err"
+check $? "tighten with no options: $(cat "$tmp/err")"
+node -e '
+const j = JSON.parse(require("fs").readFileSync(process.argv[1], "utf8")), o = j.options;
+const tight = 8 * Math.PI;
+if (j.stop_reason !== "converged") throw new Error(`stopped: ${j.stop_reason}`);
+if (!(j.ropelength > tight && j.ropelength < tight * 1.001)) throw new Error(`ropelength ${j.ropelength}`);
+if (!(o.resolution === 5 && o.autoscale === true && o.converge === true && o.time === 120 && o.steps === 0))
+    throw new Error(`options ${JSON.stringify(o)}`);
+' "$tmp/default.json"
+check $? "no options: converged at the tight Hopf link ($(head -c 300 "$tmp/default.json"))"
 # escapes: a Hopf link tightened to convergence is deformed and tightened
 # again; the same seed gives the same figures, the result is no worse than
 # any escape reached, and the log counts the tries
@@ -249,6 +269,54 @@ check $? "-o - and --struts - together: usage error: $(cat "$tmp/err")"
 "$tk" tighten "$tmp/trefoil.vect" --log - >/dev/null 2>"$tmp/err"
 [ $? -eq 1 ] && grep -q "name a file" "$tmp/err"
 check $? "--log -: usage error: $(cat "$tmp/err")"
+
+
+# --progress when standard error is not a terminal: plain lines with the
+# share of the budget and the time left; no nan at the start
+"$tk" tighten "$tmp/trefoil.vect" --autoscale --steps 300 --progress >/dev/null 2>"$tmp/progress"
+check $? "tighten --progress: $(head -c 200 "$tmp/progress")"
+grep -q "^tightknot: step       0 .*residual - .*  0% of the budget" "$tmp/progress" &&
+    grep -q "of the budget, [0-9]* s left" "$tmp/progress" && ! grep -qi nan "$tmp/progress"
+check $? "--progress lines: $(head -c 400 "$tmp/progress")"
+
+# the flow time: every logged step's is the step sizes summed
+"$tk" tighten "$tmp/hopf.vect" --autoscale --steps 400 --escapes 0 --log "$tmp/film.tsv" \
+    --snapshots "$tmp/snaps" --every 10 >/dev/null 2>"$tmp/err"
+check $? "tighten with snapshots: $(cat "$tmp/err")"
+awk -F'\t' 'NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
+    { sum += $col["step_size"]; d = $col["flow_time"] - sum; if (d < 0) d = -d
+      if (d > 1e-12 * (sum > 1 ? sum : 1)) { print "step " $1 ": " $col["flow_time"] " against " sum; bad = 1 } }
+    END { exit bad || NR < 400 }' "$tmp/film.tsv"
+check $? "flow_time is the step sizes summed"
+# frames at equal flow time, checked against every snapshot (brute force):
+# no snapshot is nearer a film frame's time than the one picked
+"$tk" frames "$tmp/film.tsv" "$tmp/snaps" --count 25 -o "$tmp/film" >"$tmp/frames.tsv" 2>"$tmp/err"
+check $? "frames: $(cat "$tmp/err")"
+[ "$(ls "$tmp/film" | wc -l)" -eq 25 ] && [ "$(tail -n +2 "$tmp/frames.tsv" | wc -l)" -eq 25 ]
+check $? "frames --count 25 writes 25 frames: $(ls "$tmp/film" | head -3)"
+awk -F'\t' 'FNR == 1 { f++; if (f == 1) for (i = 1; i <= NF; i++) col[$i] = i; next }
+    f == 1 { if ($1 % 10 == 0 && !($1 in t)) { t[$1] = $col["flow_time"]; n++ } next }
+    { pick[$1] = $2; m = $1 }
+    END { lo = t[0]; hi = 0; for (s in t) if (t[s] > hi) hi = t[s]
+          for (k = 1; k <= m; k++) { want = lo + (hi - lo) * (k - 1) / (m - 1)
+              d = t[pick[k]] - want; if (d < 0) d = -d
+              for (s in t) { e = t[s] - want; if (e < 0) e = -e; if (e < d - 1e-12) { print "frame " k ": step " pick[k] ", step " s " is nearer"; bad = 1 } } }
+          exit bad || m != 25 }' "$tmp/film.tsv" "$tmp/frames.tsv"
+check $? "each film frame is the snapshot nearest its time"
+cmp -s "$tmp/film/frame-0001.vect" "$tmp/snaps/step-000000.vect" &&
+    cmp -s "$tmp/film/frame-0025.vect" "$tmp/snaps/step-000400.vect"
+check $? "the film runs from the first snapshot to the last"
+span=$(tail -n 1 "$tmp/frames.tsv" | cut -f3) # the first frame's time is 0
+"$tk" frames "$tmp/film.tsv" "$tmp/snaps" --every-time "$span" -o "$tmp/film2" >/dev/null 2>"$tmp/err"
+[ $? -eq 0 ] && [ "$(ls "$tmp/film2" | wc -l)" -eq 2 ]
+check $? "frames --every-time the whole span: the first and the last ($(ls "$tmp/film2" | tr '\n' ' ') $(cat "$tmp/err"))"
+printf 'step\tropelength\n0\t1\n' >"$tmp/nolog.tsv"
+"$tk" frames "$tmp/nolog.tsv" "$tmp/snaps" >/dev/null 2>"$tmp/err"
+[ $? -eq 2 ] && grep -q "nolog.tsv:1: no step and flow_time columns" "$tmp/err"
+check $? "frames with a log lacking flow_time: exit 2, the line named: $(cat "$tmp/err")"
+"$tk" frames "$tmp/film.tsv" >/dev/null 2>"$tmp/err"
+[ $? -eq 1 ]
+check $? "frames without DIR: usage error: $(cat "$tmp/err")"
 
 echo "cli-tighten: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -70,10 +70,12 @@ END_TEST
 START_TEST(json_options_round_trip)
 {
     tk_job_options o = TK_JOB_OPTIONS_INIT;
-    json_t *in = json_pack("{s:f, s:i, s:i, s:f, s:f, s:f, s:f, s:b, s:i, s:i, s:i, s:b, s:f, s:f}",
+    json_t *in = json_pack("{s:f, s:i, s:i, s:f, s:f, s:f, s:f, s:b, s:i, s:i, s:i, s:b, s:f, s:f, "
+                           "s:b}",
                            "resolution", 5.0, "vertices", 0, "steps", 300, "time", 0.0, "residual", 0.01,
                            "radius", 0.5, "lambda", 2.0, "autoscale", 1, "every", 25, "escapes",
-                           0, "seed", 7, "coarse", 0, "overstep", 2e-5, "re_resolve", 0.0);
+                           0, "seed", 7, "coarse", 0, "overstep", 2e-5, "re_resolve", 0.0,
+                           "converge", 1);
     tk_error err;
     ck_assert_int_eq(tk_job_options_from_json(&o, in, NULL, &err), TK_OK);
     json_t *doc = tk_job_new("knot", NULL, &o, 1, 3);
@@ -119,25 +121,54 @@ START_TEST(bad_json_points_at_the_option)
 }
 END_TEST
 
-START_TEST(no_stop_criterion_means_the_default_steps)
+/* No stop criterion: the defaults that tighten, shown in the job; a time
+ * given is run out (no converge), with the rest of them; steps (or a
+ * residual, a change) leave the options as given. */
+START_TEST(no_stop_criterion_means_the_defaults_that_tighten)
 {
     tk_job_options o = TK_JOB_OPTIONS_INIT;
     tk_job_options_complete(&o);
-    ck_assert_int_eq(o.run.max_steps, TK_DEFAULT_STEPS);
+    ck_assert_int_eq(o.run.max_steps, 0);
+    ck_assert(o.run.max_seconds == TK_DEFAULT_SECONDS && o.run.converge && o.run.autoscale);
+    ck_assert(o.run.resolution == TK_DEFAULT_RESOLUTION && o.run.vertices == 0);
+    tk_error err;
     o = (tk_job_options)TK_JOB_OPTIONS_INIT;
-    o.run.max_seconds = 3.0;
-    o.run.radius = 2.0;
+    ck_assert_int_eq(tk_job_option_set_text(&o, "time", "3", &err), TK_OK);
+    ck_assert_int_eq(tk_job_option_set_text(&o, "radius", "2", &err), TK_OK);
+    ck_assert_int_eq(tk_job_option_set_text(&o, "vertices", "300", &err), TK_OK);
     tk_job_options_complete(&o);
     ck_assert_int_eq(o.run.max_steps, 0);
-    ck_assert(o.run.max_seconds == 3.0 && o.run.radius == 2.0);
+    ck_assert(o.run.max_seconds == 3.0 && o.run.radius == 2.0 && !o.run.converge);
+    ck_assert(o.run.autoscale);
+    ck_assert(o.run.vertices == 300 && o.run.resolution == 0.0); /* a count given: kept */
+    /* what is given keeps its value, the default too: no autoscale, the
+     * input's vertices, no converge (a cap of 120 s still) */
+    o = (tk_job_options)TK_JOB_OPTIONS_INIT;
+    json_t *given = json_pack("{s:b, s:f, s:b}", "autoscale", 0, "resolution", 0.0, "converge", 0);
+    ck_assert_int_eq(tk_job_options_from_json(&o, given, NULL, &err), TK_OK);
+    json_decref(given);
+    tk_job_options_complete(&o);
+    ck_assert(!o.run.autoscale && o.run.resolution == 0.0 && !o.run.converge);
+    ck_assert(o.run.max_seconds == TK_DEFAULT_SECONDS);
+    /* a time of 0 given (no limit): converged, with no cap */
+    o = (tk_job_options)TK_JOB_OPTIONS_INIT;
+    ck_assert_int_eq(tk_job_option_set_text(&o, "time", "0", &err), TK_OK);
+    tk_job_options_complete(&o);
+    ck_assert(o.run.max_seconds == 0.0 && o.run.converge);
     /* the engine's own defaults stay for what a job does not set */
     tk_options defaults = TK_OPTIONS_INIT;
     ck_assert(o.run.overstep_tolerance == defaults.overstep_tolerance);
-    /* a new job shows the budget it runs with */
+    o = (tk_job_options)TK_JOB_OPTIONS_INIT;
+    o.run.max_steps = 50;
+    tk_job_options_complete(&o);
+    ck_assert(o.run.max_steps == 50 && !o.run.converge && !o.run.autoscale);
+    ck_assert(o.run.max_seconds == 0.0 && o.run.resolution == 0.0);
+    /* a new job shows the options it runs with */
     tk_job_options none = TK_JOB_OPTIONS_INIT;
     json_t *doc = tk_job_new("knot", NULL, &none, 1, 3);
-    ck_assert_int_eq(json_integer_value(json_object_get(json_object_get(doc, "options"), "steps")),
-                     TK_DEFAULT_STEPS);
+    json_t *opts = json_object_get(doc, "options");
+    ck_assert(json_real_value(json_object_get(opts, "time")) == TK_DEFAULT_SECONDS);
+    ck_assert(json_is_true(json_object_get(opts, "converge")));
     json_decref(doc);
 }
 END_TEST
@@ -191,7 +222,7 @@ int main(void)
     tcase_add_test(tc, bad_values_name_the_option);
     tcase_add_test(tc, json_options_round_trip);
     tcase_add_test(tc, bad_json_points_at_the_option);
-    tcase_add_test(tc, no_stop_criterion_means_the_default_steps);
+    tcase_add_test(tc, no_stop_criterion_means_the_defaults_that_tighten);
     tcase_add_test(tc, the_document_carries_the_step_figures);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);

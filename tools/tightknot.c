@@ -44,6 +44,7 @@
 #include "tk/tighten.h"
 #include "tk/vect.h"
 
+#include "frames.h"
 #include "remote.h"
 
 #include <sys/stat.h>
@@ -74,7 +75,8 @@ static const char main_help[] =
     "             file's type (deform FILE, relax FILE, turn FILE, wander FILE)\n"
     "  tighten    tighten a knot or link: shorten it keeping the tube embedded\n"
     "  remote     use a tightknot service: submit files, list, status, cancel,\n"
-    "             delete and fetch jobs\n"
+    "             delete and fetch jobs, a job's film frames\n"
+    "  frames     a film's frames at equal flow time from a run's snapshots\n"
     "  help       show the help of a command: tightknot help info\n"
     "\n"
     "A FILE is a path, '-' for standard input, or the name of a knot of the\n"
@@ -257,8 +259,16 @@ static const char tighten_help[] =
 
 static const char tighten_help_end[] =
     "\n"
-    "With none of --steps, --time and --residual the run stops after 1000\n"
-    "steps; otherwise at the first criterion met.\n"
+    "A run stops at the first of its stop criteria met.\n"
+    "\n"
+    "Defaults that tighten: with neither --steps nor --residual (the stops\n"
+    "that end the flow at a chosen point, to compare runs) a run goes coarse\n"
+    "to fine at --resolution 5 (unless a resolution or --vertices is given),\n"
+    "autoscales and tries its escapes; given no --time either, it stops when\n"
+    "it has converged as far as its tolerances allow, or after 120 s:\n"
+    "'tightknot tighten 4.1' ends at the tight figure-eight.  A --time is run\n"
+    "out (add --converge to stop sooner when converged).  With --steps or\n"
+    "--residual every option is as given.\n"
     "\n"
     "Outputs:\n"
     "  -o, --output OUT.vect   the tightened curve (VECT)\n"
@@ -293,7 +303,9 @@ static const char tighten_help_end[] =
     "                          by their length alone or after their correction\n"
     "  -h, --help              show this help\n"
     "\n"
-    "A progress line goes to standard error when it is a terminal.  The\n"
+    "A progress line (with the share of the budget spent and the time left)\n"
+    "goes to standard error when it is a terminal; --progress prints it\n"
+    "there every 5 s when it is not.  The\n"
     "conventions are those of 'tightknot info': thickness is the tube\n"
     "diameter, ropelength = 2 * length / thickness.\n"
     "\n"
@@ -316,11 +328,13 @@ enum { CMD_INFO = 1u, CMD_STRUTS = 2u, CMD_GENERATE = 4u, CMD_TIGHTEN = 8u };
 typedef struct cli_args {
     bool help;
     bool json;
+    bool progress;        /* tighten: plain progress lines on stderr */
     double tolerance;
     size_t vertices;      /* 0: the generator's default */
     const char *disguise; /* generate: tk_generate_disguise with seed */
     unsigned long long seed;
     tk_options run;       /* tighten's run options */
+    tk_options_given given; /* those on the line */
     const char *output, *struts_out, *log_out, *snapshots;
     size_t every;
     int npos;             /* the arguments that are not options, in order */
@@ -405,12 +419,16 @@ static int parse_args(const char *name, int argc, char **argv, unsigned cmd, cli
         tk_cli_text(&c, "struts", 0, "OUT", &a->struts_out, NULL);
         tk_cli_text(&c, "log", 0, "OUT", &a->log_out, NULL);
         tk_cli_text(&c, "snapshots", 0, "DIR", &a->snapshots, NULL);
+        tk_cli_flag(&c, "progress", 0, &a->progress, NULL);
         tk_cli_fields(&c, &own_fields[OWN_EVERY], 1, a);
         tk_cli_fields(&c, tk_option_fields, tk_option_nfields, &a->run);
     }
     tk_error err;
     if (tk_cli_parse(&c, argc, argv, &a->npos, &err))
         return usage_error(name, "%s", err.message);
+    for (size_t i = 0; i < tk_option_nfields; i++)
+        if (tk_option_fields[i].name && tk_cli_given(&c, &a->run, tk_option_fields[i].name))
+            tk_options_given_mark(&a->given, tk_option_fields[i].name);
     if (a->disguise && tk_field_parse(&own_fields[OWN_SEED], a, a->disguise, &err))
         return usage_error(name, "--disguise: '%s' is not an integer from 0 to 2^53", a->disguise);
     a->pos = argv;
@@ -941,14 +959,77 @@ static int cmd_generate(int argc, char **argv)
 
 /* What the tighten command's progress callback needs. */
 typedef struct tighten_watch {
-    bool terminal;       /* progress line on stderr */
+    bool terminal;       /* a progress line on stderr, rewritten in place */
+    bool plain;          /* --progress: a progress line on stderr every PLAIN_EVERY s */
     double last_print;   /* seconds of the last progress line */
     FILE *log;
     const char *snapshots;
     size_t every;
     tk_run *run;
+    const tk_options *opt;
     int failed;          /* an output could not be written */
 } tighten_watch;
+
+#define PLAIN_EVERY 5.0
+
+/* The share of the budget spent and the time left, when the run has a
+ * budget: "37% of the budget, 76 s left"; a time budget bounds what is
+ * left (a run that converges stops sooner), steps are reckoned at the
+ * pace so far. */
+static void budget_text(const tk_options *o, const tk_step_report *s, char *buf, size_t n)
+{
+    double f = tk_options_spent(o, s);
+    buf[0] = '\0';
+    if (f < 0.0)
+        return;
+    double left = INFINITY;
+    if (o->max_seconds > 0.0)
+        left = o->max_seconds - s->seconds;
+    if (o->max_steps > 0 && s->step > 0)
+        left = fmin(left, s->seconds * (double)(o->max_steps - s->step) / (double)s->step);
+    int len = snprintf(buf, n, "  %3.0f%% of the budget", 100.0 * fmin(f, 1.0));
+    if (isfinite(left) && len > 0 && (size_t)len < n)
+        snprintf(buf + len, n - (size_t)len, ", %s%.0f s left",
+                 o->converge ? "at most " : "", fmax(left, 0.0));
+}
+
+/* How a run with these options stops, in words: "when converged or after
+ * 120 s", the options' stop criteria in the order they are judged. */
+static void stops_text(const tk_options *o, char *buf, size_t n)
+{
+    size_t len = 0;
+    buf[0] = '\0';
+#define STOP_PART(...)                                                                    \
+    do {                                                                                  \
+        if (len < n)                                                                      \
+            len += (size_t)snprintf(buf + len, n - len, "%s", len ? " or " : "");         \
+        if (len < n)                                                                      \
+            len += (size_t)snprintf(buf + len, n - len, __VA_ARGS__);                     \
+    } while (0)
+    if (o->converge)
+        STOP_PART("when converged");
+    if (o->min_residual > 0.0)
+        STOP_PART("at a residual below %g", o->min_residual);
+    if (o->min_change > 0.0)
+        STOP_PART("when the ropelength falls by less than %g", o->min_change);
+    if (o->max_steps > 0)
+        STOP_PART("after %ld steps", o->max_steps);
+    if (o->max_seconds > 0.0)
+        STOP_PART("after %g s (--time)", o->max_seconds);
+#undef STOP_PART
+}
+
+static void print_progress(tighten_watch *w, const tk_step_report *s)
+{
+    char budget[96], residual[32] = "-";
+    budget_text(w->opt, s, budget, sizeof budget);
+    if (s->step > 0) /* the start has no step to measure */
+        snprintf(residual, sizeof residual, "%.3g", s->residual);
+    fprintf(stderr, "%sstep %7ld  ropelength %.6f  struts %5zu  kinks %4zu  residual %s  %.1f s%s%s",
+            w->terminal ? "\r" : "tightknot: ", s->step, s->ropelength, s->struts, s->kinks,
+            residual, s->seconds, budget, w->terminal ? " " : "\n");
+    fflush(stderr);
+}
 
 /* "-" as an output path: standard output (the report that follows it then
  * goes to standard error, to_stderr_after). */
@@ -1007,11 +1088,11 @@ static int tighten_progress(const tk_step_report *s, void *user)
             return 1;
         }
     }
-    if (w->terminal && (s->seconds - w->last_print > 0.2 || s->step == 1)) {
+    double every = w->terminal ? 0.2 : PLAIN_EVERY;
+    if ((w->terminal || w->plain) &&
+        (s->seconds - w->last_print >= every || s->step <= 1 || w->last_print < 0.0)) {
         w->last_print = s->seconds;
-        fprintf(stderr, "\rstep %7ld  ropelength %.6f  struts %5zu  kinks %4zu  residual %.3g  %.1f s ",
-                s->step, s->ropelength, s->struts, s->kinks, s->residual, s->seconds);
-        fflush(stderr);
+        print_progress(w, s);
     }
     return 0;
 }
@@ -1065,8 +1146,7 @@ static int cmd_tighten(int argc, char **argv)
     if (a.npos != 1)
         return usage_error("tighten", a.npos == 0 ? "no FILE given" : "one FILE only");
     tk_options run_opts = a.run;
-    if (!tk_options_have_stop(&run_opts))
-        run_opts.max_steps = TK_DEFAULT_STEPS;
+    tk_options_complete(&run_opts, &a.given);
     if (run_opts.re_resolve > 0.0 && !(run_opts.resolution > 0.0))
         return usage_error("tighten", "--re-resolve needs --resolution (the vertices per unit "
                                       "ropelength to keep)");
@@ -1090,7 +1170,9 @@ static int cmd_tighten(int argc, char **argv)
         tk_curve_free(&c);
         return EXIT_INPUT;
     }
-    tighten_watch w = {isatty(STDERR_FILENO) != 0, -1.0, NULL, a.snapshots, a.every, NULL, 0};
+    bool terminal = isatty(STDERR_FILENO) != 0;
+    tighten_watch w = {terminal, a.progress && !terminal, -1.0, NULL, a.snapshots, a.every, NULL,
+                       &run_opts, 0};
     if (a.log_out) {
         w.log = fopen(a.log_out, "w");
         if (!w.log) {
@@ -1109,6 +1191,16 @@ static int cmd_tighten(int argc, char **argv)
         goto done;
     }
     w.run = run;
+    char stops[160];
+    stops_text(&run_opts, stops, sizeof stops);
+    if (w.terminal || w.plain) {
+        fprintf(stderr, "tightknot: tightening %s", name);
+        if (run_opts.resolution > 0.0)
+            fprintf(stderr, " at resolution %g", run_opts.resolution);
+        else if (run_opts.vertices > 0)
+            fprintf(stderr, " on %zu vertices", run_opts.vertices);
+        fprintf(stderr, "; it stops %s\n", stops);
+    }
     tighten_progress(tk_run_latest(run), &w);
     tk_run_set_progress(run, tighten_progress, &w);
     tk_stop_reason why = TK_STOP_NONE;
@@ -1205,6 +1297,12 @@ static int cmd_tighten(int argc, char **argv)
                 printf("reached %.9g%s\n", e[k].reached, e[k].improved ? " (better)" : "");
         }
         print_basins(tk_json_basins(e, ne, last->ropelength));
+        printf("  settings: ");
+        if (run_opts.resolution > 0.0)
+            printf("resolution %g, ", run_opts.resolution);
+        else if (run_opts.vertices > 0)
+            printf("%zu vertices, ", run_opts.vertices);
+        printf("%sstops %s\n", run_opts.autoscale ? "autoscale, " : "", stops);
     }
 done:
     if (w.log && fclose(w.log) != 0) {
@@ -1219,6 +1317,11 @@ done:
 static int cmd_remote(int argc, char **argv)
 {
     return tk_remote_main(argc, argv);
+}
+
+static int cmd_frames(int argc, char **argv)
+{
+    return tk_frames_main(argc, argv);
 }
 
 static int cmd_help(int argc, char **argv)
@@ -1239,6 +1342,8 @@ static int cmd_help(int argc, char **argv)
         fputs(tighten_help, stdout);
     else if (strcmp(argv[0], "remote") == 0)
         fputs(tk_remote_help, stdout);
+    else if (strcmp(argv[0], "frames") == 0)
+        fputs(tk_frames_help, stdout);
     else if (strcmp(argv[0], "help") == 0)
         fputs(main_help, stdout);
     else
@@ -1259,6 +1364,7 @@ static const command commands[] = {
     {"generate", cmd_generate},
     {"tighten", cmd_tighten},
     {"remote", cmd_remote},
+    {"frames", cmd_frames},
     {"help", cmd_help},
 };
 

@@ -58,8 +58,9 @@ const char tk_remote_help[] =
     "Run options: those of tightknot tighten, by the same names (see\n"
     "'tightknot tighten --help': --resolution R, --steps N, --time SECONDS,\n"
     "--residual X, --autoscale, --escapes N, ...), and --every K (keep a\n"
-    "frame every K steps).  With none of steps, time and residual a job\n"
-    "stops after 1000 steps.\n"
+    "frame every K steps).  With neither steps nor residual a job gets the\n"
+    "defaults that tighten: resolution 5, autoscale, and with no time, stop\n"
+    "when converged or after 120 s.\n"
     "\n"
     "Options:\n"
     "  --server URL   the service (default $TIGHTKNOT_SERVER, else\n"
@@ -69,15 +70,17 @@ const char tk_remote_help[] =
     "  --cacert FILE  the certificate (PEM) of the CA that signed an https\n"
     "                 server's certificate, for a private CA (the system's CAs\n"
     "                 otherwise); the server's name is always verified\n"
-    "  --poll SECONDS how often to ask for progress (default 1)\n"
+    "  --poll SECONDS how often to ask for progress (default 1)\n"    "  --progress     submit: a progress line (the share of the jobs' budgets\n"
+    "                 spent, the time left) every 10 s on standard error when\n"
+    "                 it is not a terminal (on a terminal it is always shown)\n"
     "  --json         status and list: print the jobs as JSON, one per line\n"
     "\n"
     "Exit status: 0 all done, 1 usage error, 2 some job failed or a file was\n"
     "refused, 3 the server could not be reached or answered with an error.\n"
     "\n"
-    "Example (the whole catalogue on a remote server):\n"
+    "Example (the whole catalogue on a remote server, 300 s at most each):\n"
     "  tightknot remote --server http://tk.example.org:8080 submit \\\n"
-    "      --resolution 5 --time 300 --out results ../shared/catalogue\n";
+    "      --converge --time 300 --out results ../shared/catalogue\n";
 
 /* ------------------------------------------------------------ HTTP */
 
@@ -93,7 +96,11 @@ typedef struct client {
     const char *cacert; /* the CA that signed an https server's certificate, or NULL */
     char error[CURL_ERROR_SIZE];
     bool tty;
+    bool plain;         /* --progress: a progress line every PLAIN_EVERY s */
+    double started, last_line;
 } client;
+
+#define PLAIN_EVERY 10.0
 
 typedef struct response {
     long status;
@@ -300,6 +307,7 @@ typedef struct item {
     item_phase phase;
     char state[16];      /* the job's state when finished */
     double ropelength, thickness, residual, seconds;
+    double fraction;     /* of its budget spent, as last polled (-1: unknown) */
     long long components, vertices, struts, steps, reached;
     char *row;           /* summary row, once finished */
     char message[256];
@@ -620,28 +628,54 @@ static const tk_field run_arg_fields[] = {
     TK_FIELD_ROW(run_args, poll, poll, REAL, 1, 1e-3, 3600, "poll", ""),
 };
 
+static double now_seconds(void);
+
+/* The batch's progress: the files finished, and the share of their
+ * budgets the running ones have spent, with the time left at the pace so
+ * far ("37%, about 4 min left"; unknown while no job has a budget). */
 static void progress_line(client *c, const item *items, size_t n, const char *last)
 {
-    if (!c->tty)
+    double now = now_seconds();
+    if (!c->tty && !(c->plain && now - c->last_line >= PLAIN_EVERY))
         return;
+    c->last_line = now;
     size_t done = 0, running = 0, failed = 0;
+    double share = 0.0;
+    bool known = true;
     for (size_t i = 0; i < n; i++) {
-        if (items[i].phase == ITEM_RUNNING)
+        if (items[i].phase == ITEM_RUNNING) {
             running++;
-        else if (items[i].phase == ITEM_FINISHED) {
+            known = known && items[i].fraction >= 0.0;
+            share += fmax(items[i].fraction, 0.0);
+        } else if (items[i].phase == ITEM_FINISHED) {
             done++;
+            share += 1.0;
             if (strcmp(items[i].state, "done"))
                 failed++;
         }
     }
+    double p = n ? share / (double)n : 1.0;
+    char left[64] = "";
+    if (known && p > 0.0 && p < 1.0) {
+        double t = (now - c->started) * (1.0 - p) / p;
+        if (t < 120.0)
+            snprintf(left, sizeof left, ", about %.0f s left", t);
+        else
+            snprintf(left, sizeof left, ", about %.0f min left", t / 60.0);
+    }
+    if (!c->tty) {
+        fprintf(stderr, "tightknot remote: %3.0f%%%s: %zu/%zu finished, %zu running, %zu failed\n",
+                100.0 * p, left, done, n, running, failed);
+        return;
+    }
     int width = 30;
-    int filled = n ? (int)((double)width * (double)done / (double)n) : width;
+    int filled = (int)((double)width * p);
     char bar[64];
     for (int i = 0; i < width; i++)
         bar[i] = i < filled ? '=' : ' ';
     bar[width] = '\0';
-    fprintf(stderr, "\r[%s] %zu/%zu finished, %zu running, %zu failed  %-40.40s", bar, done, n,
-            running, failed, last ? last : "");
+    fprintf(stderr, "\r[%s] %3.0f%%%s  %zu/%zu finished, %zu running, %zu failed  %-30.30s", bar,
+            100.0 * p, left, done, n, running, failed, last ? last : "");
     fflush(stderr);
 }
 
@@ -777,6 +811,8 @@ static int cmd_submit(client *c, const run_args *a, int argc, char **argv)
                 report_item(c, it);
             } else {
                 last = it->name;
+                json_t *f = json_object_get(json_object_get(job, "progress"), "fraction");
+                it->fraction = json_is_number(f) ? json_number_value(f) : -1.0;
             }
             json_decref(job);
             free(r.body.data);
@@ -990,11 +1026,12 @@ int tk_remote_main(int argc, char **argv)
         server = "http://127.0.0.1:8080";
     run_args a = {.out = "tightknot-results"};
     tk_cli_defaults(run_arg_fields, 2, &a);
-    bool json = false, help = false;
+    bool json = false, help = false, progress = false;
     tk_job_options job = TK_JOB_OPTIONS_INIT;
     tk_cli cli = {.n = 0};
     tk_cli_flag(&cli, "help", 'h', &help, NULL);
     tk_cli_flag(&cli, "json", 0, &json, NULL);
+    tk_cli_flag(&cli, "progress", 0, &progress, NULL);
     tk_cli_text(&cli, "server", 0, "URL", &server, NULL);
     tk_cli_text(&cli, "token", 0, "TOKEN", &token, NULL);
     const char *cacert = NULL;
@@ -1020,14 +1057,15 @@ int tk_remote_main(int argc, char **argv)
     const char *command = argv[0];
     char **rest = argv + 1;
     int nrest = npos - 1, status = REMOTE_OK;
-    /* the options as a query string, only those that differ from the
-     * defaults, so the server's defaults stay the server's */
+    /* the options as a query string, only those given or that differ from
+     * the defaults, so the server's defaults stay the server's */
     tk_job_options defaults = TK_JOB_OPTIONS_INIT;
     size_t q = 0;
     for (size_t k = 0; k < tk_job_option_nfields; k++) {
         const tk_field *f = &tk_job_option_fields[k];
         double x = tk_field_get(f, &job);
-        if (f->name && x != tk_field_get(f, &defaults) && q < sizeof a.query)
+        if (f->name && (x != tk_field_get(f, &defaults) || tk_cli_given(&cli, &job, f->name)) &&
+            q < sizeof a.query)
             q += (size_t)(f->kind == TK_KIND_BOOL
                               ? snprintf(a.query + q, sizeof a.query - q, "&%s=%s", f->name,
                                          x != 0.0 ? "true" : "false")
@@ -1053,6 +1091,9 @@ int tk_remote_main(int argc, char **argv)
         return REMOTE_USAGE;
     }
     c.tty = isatty(STDERR_FILENO) != 0;
+    c.plain = progress && !c.tty;
+    c.started = now_seconds();
+    c.last_line = -INFINITY;
     if (curl_global_init(CURL_GLOBAL_DEFAULT) != CURLE_OK || !(c.curl = curl_easy_init())) {
         fprintf(stderr, "tightknot remote: cannot start libcurl\n");
         return REMOTE_FAILED;

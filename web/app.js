@@ -4,6 +4,7 @@ import { api, ApiError, auth, fetchFile, TERMINAL } from './api.js';
 import { parseVect, splitFlat, torusLink, scaleToFit, writeVect } from './geometry.js';
 import { drawHistory, drawContactMap, fmtForce } from './charts.js';
 import { createView, forceColour, rampCss } from './view3d.js';
+import { equalTimeFrames, frameFlowTimes, recordCanvas, webmType } from './film.js';
 
 const $ = (id) => document.getElementById(id);
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
@@ -12,6 +13,8 @@ const POLL_MS = 300;          // live figures, ~3 times a second
 const DATA_MS = 2000;         // curve, struts and history while running
 const JOBS_MS = 2000;         // the job list
 const FRAME_PAGE = 200;       // the API's largest page of frames
+const FILM_FRAMES = 200;      // a film's frames, at equal flow time
+const FILM_FPS = 25;
 
 const state = {
     source: 'catalogue',
@@ -249,7 +252,8 @@ function readOptions() {
     num('opt-every', 'every');
     num('opt-radius', 'radius');
     num('opt-lambda', 'lambda');
-    if ($('opt-autoscale').checked) opts.autoscale = true;
+    opts.autoscale = $('opt-autoscale').checked;
+    opts.converge = $('opt-converge').checked;
     return opts;
 }
 
@@ -632,6 +636,7 @@ function setHot(i) {
 
 function resetReplay(label) {
     $('replay-play').disabled = true;
+    $('export-film').disabled = true;
     $('replay-slider').disabled = true;
     $('replay-slider').max = 0;
     $('replay-slider').value = 0;
@@ -663,6 +668,7 @@ async function loadFrames(job, live) {
     $('replay-slider').value = n - 1;
     $('replay-slider').disabled = false;
     $('replay-play').disabled = false;
+    $('export-film').disabled = !webmType();
     $('replay-label').textContent = `${n} frames`;
 }
 
@@ -807,6 +813,39 @@ async function exportPng() {
     if (blob) saveBlob(blob, exportName('view.png'));
 }
 
+// The run's film: FILM_FRAMES frames at equal flow time (film.js), each
+// frame's flow time read off the job's stored steps, recorded from the
+// 3-D view as WebM.  The steps shown are left on the button
+// (data-steps) with their flow times (data-times).
+async function exportFilm() {
+    const button = $('export-film');
+    const job = state.job;
+    if (!view || view.unavailable || !job || !state.frames.length || button.disabled) return;
+    stopPlay();
+    button.disabled = true;
+    const label = button.textContent;
+    try {
+        const hist = await api.history(job.id, 2000);
+        const times = frameFlowTimes(state.frames.map((f) => f.step), hist.steps);
+        if (!times) throw new Error('this job\'s steps carry no flow time (stored by an older daemon)');
+        const count = Math.min(FILM_FRAMES, Math.max(2, state.frames.length));
+        const picks = equalTimeFrames(times, count);
+        button.textContent = 'recording…';
+        const blob = await recordCanvas(view.renderer.domElement, picks.length, FILM_FPS, (k) => {
+            showFrame(picks[k]);
+            view.renderNow();
+        });
+        button.dataset.steps = picks.map((i) => state.frames[i].step).join(' ');
+        button.dataset.times = picks.map((i) => times[i]).join(' ');
+        saveBlob(blob, exportName('film.webm'));
+    } catch (err) {
+        showProblem($('job-error'), err);
+    } finally {
+        button.textContent = label;
+        button.disabled = !state.frames.length || !webmType();
+    }
+}
+
 // ------------------------------------------------------------------ wiring
 
 function wire() {
@@ -869,6 +908,7 @@ function wire() {
     $('tube-opacity').addEventListener('input', () => view?.setOpacity(Number($('tube-opacity').value)));
     $('fit-view').addEventListener('click', () => view?.fit());
     $('export-png').addEventListener('click', exportPng);
+    $('export-film').addEventListener('click', exportFilm);
     $('export-chart').addEventListener('click', () => saveBlob(standaloneSvg($('chart')), exportName('ropelength.svg')));
     $('export-map').addEventListener('click', () => saveBlob(standaloneSvg($('contact-map')), exportName('contacts.svg')));
 

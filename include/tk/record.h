@@ -73,7 +73,34 @@ int tk_field_parse(const tk_field *f, void *record, const char *text, tk_error *
  * other (re_resolve and snapshots exclude each other). */
 int tk_options_check(const tk_options *o, tk_error *err);
 
-/* Whether some stop criterion is set (steps, time, residual, change). */
+/* Whether some stop criterion is set (steps, time, residual, change,
+ * converge). */
 bool tk_options_have_stop(const tk_options *o);
+
+/* The share of its budget (steps, time: the larger share) a run has
+ * spent at the step report s, not capped at 1; -1 when it has no budget. */
+double tk_options_spent(const tk_options *o, const tk_step_report *s);
+
+/* Which run options a user gave (on the command line, in a job's JSON or
+ * query), whatever their values: the defaults below fill the others. */
+#define TK_FIELD_GIVEN(field, ...) bool field;
+typedef struct tk_options_given {
+    TK_OPTION_FIELDS(TK_FIELD_GIVEN)
+} tk_options_given;
+
+/* Marks the run option that users name `name` as given; false when no run
+ * option has that name. */
+bool tk_options_given_mark(tk_options_given *g, const char *name);
+
+/* The defaults that tighten, as the command line and the service apply
+ * them to what a user gave.  A run with none of steps, residual and change
+ * set (the stops that end the flow at a chosen point, to compare runs) is
+ * meant to end tight; of the options the user did not give, it goes coarse
+ * to fine at TK_DEFAULT_RESOLUTION (unless a resolution or a vertex count
+ * was given), autoscales (a start thinner than the tube can run no other
+ * way), is capped at TK_DEFAULT_SECONDS, and stops when converged unless a
+ * time was given (a time given is run out, as before these defaults).
+ * Options given keep their values; any other run is left as given. */
+void tk_options_complete(tk_options *o, const tk_options_given *given);
 
 #endif

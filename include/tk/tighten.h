@@ -95,6 +95,10 @@
     X(min_residual, REAL, 0.0, 0.0, 1.0, "residual",                                         \
       "stop when the residual |resolved gradient| / |gradient| falls below this (0: "        \
       "never)")                                                                              \
+    X(converge, BOOL, false, 0, 1, "converge",                                               \
+      "stop when the run has converged as far as its tolerances allow: on the final "        \
+      "polygon, polished to its finest tolerance, every escape tried, and the ropelength "    \
+      "no longer falling")                                                                   \
     X(min_change, REAL, 0.0, 0.0, 1.0, NULL,                                                 \
       "stop when the ropelength fell by less than this (relative) over change_window "       \
       "steps")                                                                               \
@@ -150,9 +154,12 @@ typedef struct tk_options {
  * contact was not measured. */
 #define TK_RUN_MAX_VERTICES 1000000
 
-/* With none of steps, time, residual and change set, the command line and
- * the service stop a run after this many steps. */
-#define TK_DEFAULT_STEPS 1000
+/* The defaults that tighten (tk_options_complete): a run given no stop
+ * criterion but the time goes coarse to fine at TK_DEFAULT_RESOLUTION
+ * (unless it was given a vertex count) and autoscales; given no time, it
+ * stops when converged or after TK_DEFAULT_SECONDS. */
+#define TK_DEFAULT_RESOLUTION 5.0
+#define TK_DEFAULT_SECONDS 120.0
 
 /* Why a run stopped. */
 typedef enum tk_stop_reason {
@@ -163,7 +170,8 @@ typedef enum tk_stop_reason {
     TK_STOP_CHANGE,
     TK_STOP_CANCELLED,
     TK_STOP_STALLED,       /* the step size fell to nothing */
-    TK_STOP_FAILED         /* numerical failure: see the error message */
+    TK_STOP_FAILED,        /* numerical failure: see the error message */
+    TK_STOP_CONVERGED      /* as far as its tolerances allow (converge) */
 } tk_stop_reason;
 
 const char *tk_stop_reason_name(tk_stop_reason r);
@@ -181,6 +189,9 @@ const char *tk_stop_reason_name(tk_stop_reason r);
     X(struts, SIZE, 0, 0, 0, "struts", "active struts")                                     \
     X(kinks, SIZE, 0, 0, 0, "kinks", "active kinks")                                        \
     X(step_size, REAL, 0, 0, 0, "step_size", "h of the step taken")                         \
+    X(flow_time, REAL, 0, 0, 0, "flow_time",                                                \
+      "the flow's time: the step sizes h summed since the start (a film's frames at equal "  \
+      "flow time show the flow at a constant rate, as the paper's)")                          \
     X(rcond, REAL, 0, 0, 0, "rcond",                                                        \
       "condition estimate of the NNLS's proximal normal matrix (1 without constraints)")    \
     X(violation, REAL, 0, 0, 0, "violation",                                                \
@@ -340,6 +351,7 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out);
     X(final_ropelength, REAL, 0, 0, 1e300, "final_ropelength",                              \
       "the ropelength the final polygon's vertices are reckoned from (0: not yet fixed)")    \
     X(step_size, REAL, 0, 0, 1e300, "step_size", "the last step's size")                     \
+    X(flow_time, REAL, 0, 0, 1e300, "flow_time", "the flow's time so far")                   \
     X(escapes, INT, 0, 0, 1000, "escapes", "escapes tried")                                 \
     X(draws, LONG, 0, 0, 9e15, "draws", "numbers drawn from the escapes' random stream")    \
     X(best_polish, INT, 0, 0, 1000, "best_polish", "the polishing level of the best curve")  \

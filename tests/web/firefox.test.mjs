@@ -163,6 +163,44 @@ test('Firefox: hovering a strut row marks that strut on the map', async () => {
     await page.waitForFunction(() => !document.querySelector('#contact-map .strut-mark.hot'));
 });
 
+// The exports, as Firefox saves them: the page hands each file to a link
+// it clicks; the click is caught here and the file read back from its
+// blob before the page lets it go.
+test('Firefox: the view as PNG, the chart and map as SVG, the film as WebM', async () => {
+    const id = shared.trefoil;
+    const { body: job } = await api(`/v1/jobs/${id}`);
+    await page.evaluate(() => {
+        window.savedFiles = [];
+        HTMLAnchorElement.prototype.click = function () {
+            const name = this.download;
+            fetch(this.href).then((r) => r.arrayBuffer())
+                .then((b) => window.savedFiles.push({ name, bytes: Array.from(new Uint8Array(b)) }));
+        };
+    });
+    const saved = async (n, timeout = 60000) => {
+        await page.waitForFunction((k) => window.savedFiles.length >= k, { timeout }, n);
+        return page.evaluate((k) => window.savedFiles[k - 1], n);
+    };
+    await page.click('#export-png');
+    const png = await saved(1);
+    assert.equal(png.name, `${job.name}-${id}-view.png`);
+    assert.deepEqual(png.bytes.slice(0, 4), [0x89, 0x50, 0x4e, 0x47], 'a PNG');
+    await page.click('#export-chart');
+    const chart = await saved(2);
+    assert.equal(chart.name, `${job.name}-${id}-ropelength.svg`);
+    assert.match(Buffer.from(chart.bytes).toString('utf8'), /^<\?xml [^>]*>\n<svg [^>]*xmlns="http:\/\/www\.w3\.org\/2000\/svg"/);
+    await page.click('#export-map');
+    assert.equal((await saved(3)).name, `${job.name}-${id}-contacts.svg`);
+    await page.waitForFunction(() => !document.getElementById('export-film').disabled, { timeout: 20000 });
+    await page.click('#export-film');
+    const film = await saved(4);
+    assert.equal(film.name, `${job.name}-${id}-film.webm`);
+    assert.deepEqual(film.bytes.slice(0, 4), [0x1a, 0x45, 0xdf, 0xa3], 'an EBML file');
+    assert.ok(Buffer.from(film.bytes).includes(Buffer.from('webm')), 'of DocType webm');
+    const shown = (await page.$eval('#export-film', (b) => b.dataset.steps)).split(' ').map(Number);
+    assert.equal(shown.length, Math.min(200, Math.max(2, job.frames)));
+});
+
 test('Firefox: a bad VECT is rejected with the problem\'s detail and line', async () => {
     const bad = 'VECT\n1 4 0\n-4\n0\n0 0 0\n4 0 0\nfoo 4 0\n0 4 0\n';
     const direct = await api('/v1/jobs', {

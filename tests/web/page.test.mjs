@@ -98,6 +98,23 @@ test('the page and its libraries come from the daemon, with the catalogue', asyn
     assert.deepEqual(foreign, [], 'no request leaves the daemon');
 });
 
+// The form as it loads: a catalogue link with no option touched ends
+// tight, converged before its cap, within 0.1% of the exact 8 pi.
+test('the form\'s defaults tighten: the Hopf link ends converged at 8 pi', async () => {
+    await page.click('#tab-catalogue');
+    await page.fill('#catalogue-filter', '2.2.1');
+    assert.equal(await page.inputValue('#catalogue-select'), '2.2.1');
+    const id = await submitForm();
+    const job = await waitJob(id, ['done', 'failed', 'cancelled']);
+    assert.equal(job.state, 'done', JSON.stringify(job));
+    assert.equal(job.stop_reason, 'converged');
+    const o = job.options;
+    assert.ok(o.resolution === 5 && o.autoscale === true && o.converge === true && o.time === 120 && o.steps === 0,
+        JSON.stringify(o));
+    assert.ok(job.ropelength > 8 * Math.PI && job.ropelength < 8 * Math.PI * 1.001, `ropelength ${job.ropelength}`);
+    await page.fill('#catalogue-filter', '');
+});
+
 test('a catalogue knot submitted through the form is tightened and shown', async () => {
     await page.click('#tab-catalogue');
     // a name typed exactly comes first and is picked (0.3.1 comes before
@@ -263,6 +280,42 @@ test('the 3-D view exports as PNG, the chart and the contact map as SVG files of
         assert.ok(drawn[0] > 0 && drawn[1] > 0, `drawn ${drawn}`);
         assert.doesNotMatch(text, /var\(--/, 'no stylesheet variable left unresolved');
     }
+});
+
+// The film: WebM from the 3-D view, its frames at equal flow time.  The
+// flow time is checked against its definition (the step sizes summed,
+// from the job's every stored step: 300 steps, none thinned), and every
+// film frame against all the run's frames (brute force): none is nearer
+// its time on the equal grid than the one shown.
+test('the film is a WebM of the run at equal flow time', async () => {
+    const id = shared.trefoil;
+    const { body: job } = await api(`/v1/jobs/${id}`);
+    const { body: hist } = await api(`/v1/jobs/${id}/history?limit=2000`);
+    assert.equal(hist.steps.length, job.progress.step + 1, 'every step stored');
+    let sum = 0;
+    for (const s of hist.steps) {
+        sum += s.step_size ?? 0;
+        assert.ok(Math.abs(s.flow_time - sum) <= 1e-12 * Math.max(1, sum), `step ${s.step}: flow_time ${s.flow_time}, sum of h ${sum}`);
+    }
+    const flow = new Map(hist.steps.map((s) => [s.step, s.flow_time]));
+    await page.waitForFunction(() => !document.getElementById('export-film').disabled, null, { timeout: 20000 });
+    const [film] = await Promise.all([page.waitForEvent('download', { timeout: 60000 }), page.click('#export-film')]);
+    assert.equal(film.suggestedFilename(), `${job.name}-${id}-film.webm`);
+    const bytes = readFileSync(await film.path());
+    assert.deepEqual([...bytes.subarray(0, 4)], [0x1a, 0x45, 0xdf, 0xa3], 'an EBML file');
+    assert.ok(bytes.includes(Buffer.from('webm')), 'of DocType webm');
+    assert.ok(bytes.length > 2000, `${bytes.length} bytes`);
+    const shown = (await page.getAttribute('#export-film', 'data-steps')).split(' ').map(Number);
+    const { body: fr } = await api(`/v1/jobs/${id}/frames?limit=200`);
+    const frameTimes = fr.frames.map((f) => flow.get(f.step));
+    assert.equal(shown.length, Math.min(200, Math.max(2, fr.frames.length)));
+    const t0 = frameTimes[0], t1 = frameTimes[frameTimes.length - 1];
+    shown.forEach((step, k) => {
+        const t = t0 + (t1 - t0) * k / (shown.length - 1);
+        const best = Math.min(...frameTimes.map((x) => Math.abs(x - t)));
+        assert.ok(Math.abs(flow.get(step) - t) <= best + 1e-12, `film frame ${k}: step ${step} at ${flow.get(step)}, time ${t}`);
+    });
+    assert.ok(new Set(shown).size > 2, `more than the first and last frame: ${shown}`);
 });
 
 test('a bad VECT is rejected with the problem\'s detail and line', async () => {
