@@ -23,3 +23,30 @@ void tk_film_picks(const double *times, size_t n, double every, size_t count, si
         picks[k] = j + 1 < n && times[j + 1] - t < t - times[j] ? j + 1 : j;
     }
 }
+
+void tk_film_times(const long *steps, size_t n, const long *hsteps, const double *htimes,
+                   size_t nh, double *out)
+{
+    assert(nh > 0);
+    for (size_t i = 0; i < n; i++) {
+        long step = steps[i];
+        if (step <= hsteps[0]) {
+            out[i] = htimes[0];
+            continue;
+        }
+        if (step >= hsteps[nh - 1]) {
+            out[i] = htimes[nh - 1];
+            continue;
+        }
+        size_t lo = 0, hi = nh - 1; /* hsteps[lo] < step < hsteps[hi] */
+        while (hi - lo > 1) {
+            size_t mid = lo + (hi - lo) / 2;
+            if (hsteps[mid] <= step)
+                lo = mid;
+            else
+                hi = mid;
+        }
+        out[i] = htimes[lo] + (htimes[hi] - htimes[lo]) * (double)(step - hsteps[lo]) /
+                                  (double)(hsteps[hi] - hsteps[lo]);
+    }
+}

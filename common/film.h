@@ -20,4 +20,11 @@ size_t tk_film_count(const double *times, size_t n, double every);
  * step.  `times` ascending, n > 0. */
 void tk_film_picks(const double *times, size_t n, double every, size_t count, size_t *picks);
 
+/* The flow time at each of n frames' steps, read off a thinned history
+ * (nh entries of step hsteps[i] and flow time htimes[i], steps
+ * ascending): linearly between the two entries around the step, the
+ * first's or last's beyond them, as the page's film does.  nh > 0. */
+void tk_film_times(const long *steps, size_t n, const long *hsteps, const double *htimes,
+                   size_t nh, double *out);
+
 #endif

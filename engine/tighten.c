@@ -62,8 +62,11 @@ static int record(tk_run *r, tk_step_report *rep, tk_error *err)
     rep->escapes = tk_escape_tries(r);
     rep->restarts = r->schedule.restarts;
     rep->seconds = tk_clock() - r->life.started;
-    /* a step put back (record_restored) has size 0 and keeps its time */
-    rep->flow_time = (r->life.nhistory > 0 ? r->life.latest.flow_time : r->life.flow_from) +
+    /* the step sizes of the history summed: a step put back in the place
+     * of the last (record_restored) has size 0 and the time of the one
+     * before it */
+    rep->flow_time = (r->life.nhistory > 0 ? r->life.history[r->life.nhistory - 1].flow_time
+                                           : r->life.flow_from) +
                      rep->step_size;
     if (r->life.nhistory == r->life.history_capacity) {
         size_t cap = r->life.history_capacity ? 2 * r->life.history_capacity : 256;

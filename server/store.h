@@ -50,6 +50,10 @@ void tk_store_close(tk_store **p);
 /* Whether other daemons may share the store (PostgreSQL). */
 bool tk_store_shared(const tk_store *s);
 
+/* What the store is, for logs and messages: a SQLite file's path, a
+ * PostgreSQL database's name, host and port (never a password). */
+const char *tk_store_label(const tk_store *s);
+
 /* Who claims jobs through this store: "host:pid:random", unique. */
 const char *tk_store_holder(const tk_store *s);
 

@@ -201,3 +201,8 @@ const char *tk_store_holder(const tk_store *s)
 {
     return s->holder;
 }
+
+const char *tk_store_label(const tk_store *s)
+{
+    return s->label;
+}

@@ -175,13 +175,13 @@ int main(int argc, char **argv)
         tk_tokens_free(&tokens);
         return 2;
     }
-    /* a URI may hold a password: only what kind of store it is */
+    /* a URI may hold a password: the store's label has none */
     /* every line of the log carries its time, as the pool's job lines do */
     char now[32];
     tk_time_iso(now);
     printf("tightknotd: %s listening on %s://%s:%u/ (workers %zu, store %s", now,
            tk_api_scheme(server), api.bind, tk_api_port(server), pool_cfg.workers,
-           postgres ? "PostgreSQL" : db);
+           postgres ? tk_store_label(store) : db);
     printf(" as %s", tk_store_holder(store)); /* the jobs' "daemon" */
     if (postgres)
         printf(", lease %g s", set.lease);

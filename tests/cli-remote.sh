@@ -183,6 +183,49 @@ check $? "list --json: one object a job"
 [ $? -eq 1 ] && grep -q "state" "$tmp/badstate"
 check $? "list with a bad state: usage error from the server's message: $(cat "$tmp/badstate")"
 
+# a film's frames of a job at equal flow time: each the stored frame
+# nearest its time on the equal grid, all frames tried (brute force), the
+# flow times from the job's every stored step (200 steps, none thinned),
+# the files the frames' own coordinates
+"$tk" remote --server "$url" submit --autoscale --steps 200 --every 10 --poll 0.2 \
+    --out "$tmp/fout" "$tmp/in/trefoil.vect" >/dev/null 2>"$tmp/err"
+check $? "a job with frames: $(tail -n 2 "$tmp/err")"
+fjob=$(awk -F"	" '$1 == "trefoil" {print $2; exit}' "$tmp/fout/jobs.tsv")
+"$tk" remote --server "$url" frames --count 15 --out "$tmp/frames" "$fjob" >"$tmp/frames.tsv" 2>"$tmp/err"
+check $? "remote frames exits 0: $(cat "$tmp/err")"
+[ "$(ls "$tmp/frames" | grep -c "^trefoil-$fjob-frame-00[0-9][0-9]\.vect$")" -eq 15 ]
+check $? "remote frames writes NAME-JOB-frame-KKKK.vect, 15 of them: $(ls "$tmp/frames" | head -n 2)"
+"$tk" info "$tmp/frames/trefoil-$fjob-frame-0015.vect" >/dev/null
+check $? "a frame is a VECT file"
+node -e '
+const [url, job, table, dir] = process.argv.slice(1);
+const fs = require("fs");
+(async () => {
+    const hist = await (await fetch(`${url}/v1/jobs/${job}/history?limit=2000`)).json();
+    const fr = await (await fetch(`${url}/v1/jobs/${job}/frames?limit=200`)).json();
+    const flow = new Map(hist.steps.map((s) => [s.step, s.flow_time]));
+    const times = fr.frames.map((f) => flow.get(f.step));
+    const rows = fs.readFileSync(table, "utf8").trim().split("\n").slice(1).map((l) => l.split("\t"));
+    if (rows.length !== 15) throw new Error(`${rows.length} rows`);
+    const t0 = times[0], t1 = times[times.length - 1];
+    rows.forEach(([k, step, t, file], i) => {
+        const want = t0 + (t1 - t0) * i / 14;
+        const best = Math.min(...times.map((x) => Math.abs(x - want)));
+        if (Math.abs(flow.get(Number(step)) - want) > best + 1e-12) throw new Error(`frame ${k}: step ${step}`);
+        if (Math.abs(Number(t) - flow.get(Number(step))) > 1e-12 * Math.max(1, t1)) throw new Error(`frame ${k}: time ${t}`);
+        const f = fr.frames.find((x) => x.step === Number(step));
+        const nums = fs.readFileSync(file, "utf8").replace(/#.*$/gm, "").trim().split(/\s+/).slice(1).map(Number);
+        const got = nums.slice(-f.coordinates.length);
+        if (got.some((x, j) => Math.abs(x - f.coordinates[j]) > 1e-12 * Math.max(1, Math.abs(x))))
+            throw new Error(`frame ${k}: coordinates differ from the stored frame`);
+    });
+})().catch((e) => { console.error(e.message); process.exit(1); });
+' "$url" "$fjob" "$tmp/frames.tsv" "$tmp/frames" 2>"$tmp/err"
+check $? "each film frame is the stored frame nearest its flow time: $(cat "$tmp/err")"
+"$tk" remote --server "$url" frames 999999 >/dev/null 2>"$tmp/err"
+[ $? -eq 2 ]
+check $? "frames of a missing job: exit 2 ($(cat "$tmp/err"))"
+
 # a dead server: a clear message and exit 3
 kill "$pid" && wait "$pid" 2>/dev/null
 pid=""

@@ -10,6 +10,7 @@
  */
 #include "remote.h"
 
+#include <ctype.h>
 #include <curl/curl.h>
 #include <dirent.h>
 #include <errno.h>
@@ -26,7 +27,9 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "film.h"
 #include "jobopts.h"
+#include "tk/vect.h"
 
 enum { REMOTE_OK = 0, REMOTE_USAGE = 1, REMOTE_FAILED = 2, REMOTE_SERVER = 3 };
 
@@ -53,7 +56,11 @@ const char tk_remote_help[] =
     "  cancel JOB...   cancel queued or running jobs\n"
     "  delete JOB...   delete finished jobs (done, failed or cancelled) from\n"
     "                  the server, with their results\n"
-    "  fetch [--out DIR] JOB...   download jobs' VECT and struts into DIR\n"
+    "  fetch [--out DIR] JOB...   download jobs' VECT and struts into DIR\n"    "  frames [--count N | --every-time T] [--out DIR] JOB\n"
+    "      a film's frames at equal flow time from the job's stored frames\n"
+    "      (N of them, default 200, or one every T of flow time, each\n"
+    "      frame's flow time read off the job's stored steps): DIR/NAME-JOB-\n"
+    "      frame-KKKK.vect, and a line each (frame, step, flow_time, file)\n"
     "\n"
     "Run options: those of tightknot tighten, by the same names (see\n"
     "'tightknot tighten --help': --resolution R, --steps N, --time SECONDS,\n"
@@ -621,12 +628,17 @@ typedef struct run_args {
     const char *out;
     size_t parallel;
     double poll;
+    size_t count;        /* frames: film frames */
+    double every_time;   /* frames: or one every this much flow time */
 } run_args;
 
 static const tk_field run_arg_fields[] = {
     TK_FIELD_ROW(run_args, parallel, parallel, SIZE, 4, 1, 1000, "parallel", ""),
     TK_FIELD_ROW(run_args, poll, poll, REAL, 1, 1e-3, 3600, "poll", ""),
+    TK_FIELD_ROW(run_args, count, count, SIZE, 200, 2, 1e6, "count", ""),
+    TK_FIELD_ROW(run_args, every_time, every_time, REAL, 0, 0, 1e300, "every-time", ""),
 };
+#define RUN_ARG_NFIELDS (sizeof run_arg_fields / sizeof run_arg_fields[0])
 
 static double now_seconds(void);
 
@@ -939,6 +951,155 @@ static int cmd_list(client *c, bool json, int argc, char **argv)
     return status;
 }
 
+/* GET path as JSON into *out (NULL on failure, said on stderr). */
+static int get_json(client *c, const char *path, json_t **out)
+{
+    response r = {0};
+    *out = NULL;
+    if (!request(c, "GET", path, NULL, NULL, 0, &r))
+        return REMOTE_SERVER;
+    int status = REMOTE_OK;
+    if (r.status != 200) {
+        char detail[256];
+        problem_text(&r, detail, sizeof detail);
+        fprintf(stderr, "tightknot remote: %s: %s\n", path, detail);
+        status = r.status == 404 ? REMOTE_FAILED : REMOTE_SERVER;
+    } else if (!(*out = json_loadb(r.body.data, r.body.len, 0, NULL))) {
+        fprintf(stderr, "tightknot remote: %s: the answer is not JSON\n", path);
+        status = REMOTE_SERVER;
+    }
+    free(r.body.data);
+    return status;
+}
+
+/* A frame of the API (its components and flat coordinates) as VECT. */
+static bool write_frame(const char *path, const json_t *frame)
+{
+    json_t *comps = json_object_get(frame, "components"), *xyz = json_object_get(frame, "coordinates");
+    size_t n = json_array_size(comps), total = 0;
+    size_t *counts = calloc(n ? n : 1, sizeof *counts);
+    bool *closed = calloc(n ? n : 1, sizeof *closed);
+    bool ok = counts && closed && n > 0;
+    for (size_t i = 0; ok && i < n; i++) {
+        json_t *one = json_array_get(comps, i);
+        counts[i] = (size_t)json_integer_value(json_object_get(one, "vertices"));
+        closed[i] = json_is_true(json_object_get(one, "closed"));
+        total += counts[i];
+    }
+    tk_curve *curve = NULL;
+    tk_error err;
+    ok = ok && json_array_size(xyz) == 3 * total && tk_curve_new(&curve, n, counts, closed, &err) == TK_OK;
+    for (size_t i = 0; ok && i < 3 * total; i++)
+        curve->xyz[i] = json_number_value(json_array_get(xyz, i));
+    FILE *f = ok ? fopen(path, "w") : NULL;
+    ok = f && tk_vect_write(curve, f, &err) == TK_OK;
+    if (f && fclose(f) != 0)
+        ok = false;
+    tk_curve_free(&curve);
+    free(counts);
+    free(closed);
+    return ok;
+}
+
+/* tightknot remote frames JOB: the job's frames for a film at equal flow
+ * time (common/film.h), each frame's time read off its stored steps. */
+static int cmd_frames(client *c, const run_args *a, int argc, char **argv)
+{
+    long long id;
+    if (argc != 1) {
+        fprintf(stderr, "tightknot remote frames: one JOB\nTry 'tightknot remote --help'.\n");
+        return REMOTE_USAGE;
+    }
+    if (!parse_job_id(argv[0], &id))
+        return REMOTE_USAGE;
+    char path[128], name[256];
+    json_t *job = NULL, *hist = NULL, *frames = json_array();
+    snprintf(path, sizeof path, "/v1/jobs/%lld", id);
+    int status = frames ? get_json(c, path, &job) : REMOTE_FAILED;
+    snprintf(path, sizeof path, "/v1/jobs/%lld/history?limit=2000", id);
+    if (status == REMOTE_OK)
+        status = get_json(c, path, &hist);
+    for (size_t offset = 0; status == REMOTE_OK;) {
+        json_t *page = NULL;
+        snprintf(path, sizeof path, "/v1/jobs/%lld/frames?offset=%zu&limit=200", id, offset);
+        status = get_json(c, path, &page);
+        json_t *got = json_object_get(page, "frames");
+        size_t k;
+        json_t *one;
+        json_array_foreach(got, k, one)
+            json_array_append(frames, one);
+        offset += json_array_size(got);
+        bool more = json_array_size(got) > 0 &&
+                    offset < (size_t)json_integer_value(json_object_get(page, "total"));
+        json_decref(page);
+        if (!more)
+            break;
+    }
+    size_t n = json_array_size(frames), nh = 0;
+    json_t *steps = json_object_get(hist, "steps");
+    long *fsteps = calloc(n + 1, sizeof *fsteps), *hsteps = calloc(json_array_size(steps) + 1, sizeof *hsteps);
+    double *times = calloc(n + 1, sizeof *times), *htimes = calloc(json_array_size(steps) + 1, sizeof *htimes);
+    if (status == REMOTE_OK && !(fsteps && hsteps && times && htimes))
+        status = REMOTE_FAILED;
+    for (size_t i = 0; status == REMOTE_OK && i < json_array_size(steps); i++) {
+        json_t *t = json_object_get(json_array_get(steps, i), "flow_time");
+        if (json_is_number(t)) {
+            hsteps[nh] = (long)json_integer_value(json_object_get(json_array_get(steps, i), "step"));
+            htimes[nh++] = json_number_value(t);
+        }
+    }
+    if (status == REMOTE_OK && (n == 0 || nh == 0)) {
+        fprintf(stderr, "tightknot remote frames: job %lld has %s\n", id,
+                n == 0 ? "no frames (it was submitted with every 0)"
+                       : "no flow time in its steps (stored by an older daemon)");
+        status = REMOTE_FAILED;
+    }
+    size_t count = 0, *picks = NULL;
+    if (status == REMOTE_OK) {
+        for (size_t i = 0; i < n; i++)
+            fsteps[i] = (long)json_integer_value(json_object_get(json_array_get(frames, i), "step"));
+        tk_film_times(fsteps, n, hsteps, htimes, nh, times);
+        double every = a->every_time;
+        count = every > 0.0 ? tk_film_count(times, n, every) : a->count;
+        if (!(every > 0.0))
+            every = (times[n - 1] - times[0]) / (double)(count - 1);
+        picks = count <= 10000000 ? malloc(count * sizeof *picks) : NULL;
+        if (picks)
+            tk_film_picks(times, n, every, count, picks);
+        else
+            status = REMOTE_FAILED;
+    }
+    if (status == REMOTE_OK && mkdir(a->out, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "tightknot remote: cannot make %s: %s\n", a->out, strerror(errno));
+        status = REMOTE_FAILED;
+    }
+    /* NAME-JOB-frame-KKKK.vect, the name's characters kept to a file's */
+    printable(name, sizeof name, json_string_value(json_object_get(job, "name")));
+    for (char *p = name; *p; p++)
+        if (!(isalnum((unsigned char)*p) || *p == '.' || *p == '_' || *p == '-'))
+            *p = '_';
+    if (status == REMOTE_OK)
+        printf("frame\tstep\tflow_time\tfile\n");
+    for (size_t k = 0; status == REMOTE_OK && k < count; k++) {
+        char file[4400];
+        snprintf(file, sizeof file, "%s/%s-%lld-frame-%04zu.vect", a->out, name, id, k + 1);
+        if (!write_frame(file, json_array_get(frames, picks[k]))) {
+            fprintf(stderr, "tightknot remote: cannot write %s\n", file);
+            status = REMOTE_FAILED;
+        } else
+            printf("%zu\t%ld\t%.17g\t%s\n", k + 1, fsteps[picks[k]], times[picks[k]], file);
+    }
+    free(picks);
+    free(fsteps);
+    free(hsteps);
+    free(times);
+    free(htimes);
+    json_decref(job);
+    json_decref(hist);
+    json_decref(frames);
+    return status;
+}
+
 static int cmd_jobs(client *c, const char *what, const run_args *a, bool json, int argc,
                     char **argv)
 {
@@ -1025,7 +1186,7 @@ int tk_remote_main(int argc, char **argv)
     if (!server || !*server)
         server = "http://127.0.0.1:8080";
     run_args a = {.out = "tightknot-results"};
-    tk_cli_defaults(run_arg_fields, 2, &a);
+    tk_cli_defaults(run_arg_fields, RUN_ARG_NFIELDS, &a);
     bool json = false, help = false, progress = false;
     tk_job_options job = TK_JOB_OPTIONS_INIT;
     tk_cli cli = {.n = 0};
@@ -1037,7 +1198,7 @@ int tk_remote_main(int argc, char **argv)
     const char *cacert = NULL;
     tk_cli_text(&cli, "cacert", 0, "FILE", &cacert, NULL);
     tk_cli_text(&cli, "out", 0, "DIR", &a.out, NULL);
-    tk_cli_fields(&cli, run_arg_fields, 2, &a);
+    tk_cli_fields(&cli, run_arg_fields, RUN_ARG_NFIELDS, &a);
     tk_cli_fields(&cli, tk_job_option_fields, tk_job_option_nfields, &job);
     tk_error err;
     int npos = 0;
@@ -1050,8 +1211,8 @@ int tk_remote_main(int argc, char **argv)
         return REMOTE_OK;
     }
     if (npos == 0) {
-        fprintf(stderr, "tightknot remote: no COMMAND given (submit, list, status, cancel, delete "
-                        "or fetch)\nTry 'tightknot remote --help'.\n");
+        fprintf(stderr, "tightknot remote: no COMMAND given (submit, list, status, cancel, delete, "
+                        "fetch or frames)\nTry 'tightknot remote --help'.\n");
         return REMOTE_USAGE;
     }
     const char *command = argv[0];
@@ -1105,9 +1266,11 @@ int tk_remote_main(int argc, char **argv)
     else if (!strcmp(command, "status") || !strcmp(command, "cancel") ||
              !strcmp(command, "delete") || !strcmp(command, "fetch"))
         status = cmd_jobs(&c, command, &a, json, nrest, rest);
+    else if (!strcmp(command, "frames"))
+        status = cmd_frames(&c, &a, nrest, rest);
     else {
         fprintf(stderr, "tightknot remote: unknown command '%s' (submit, list, status, "
-                        "cancel, delete or fetch)\nTry 'tightknot remote --help'.\n",
+                        "cancel, delete, fetch or frames)\nTry 'tightknot remote --help'.\n",
                 command);
         status = REMOTE_USAGE;
     }

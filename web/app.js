@@ -501,10 +501,17 @@ function showJob(job) {
     $('job-progress').style.width = `${(100 * frac).toFixed(1)}%`;
 }
 
+// The curve and its struts of one step: a running job's worker may store
+// a newer step between the two requests, so they are asked again (a few
+// times at most) until both are of the same step.
 async function loadData(job, live) {
-    const [doc, contacts, hist] = await Promise.all([
-        api.vect(job.id), api.struts(job.id), api.history(job.id, 1000),
-    ]);
+    let doc, contacts, hist;
+    for (let tries = 0; tries < 4; tries++) {
+        [doc, contacts, hist] = await Promise.all([
+            api.vect(job.id), api.struts(job.id), api.history(job.id, 1000),
+        ]);
+        if (doc.step === contacts.step || !live()) break;
+    }
     if (!live()) return;
     state.curve = { comps: parseVect(doc.vect), step: doc.step };
     state.contacts = contacts;
