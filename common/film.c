@@ -3,25 +3,27 @@
 
 #include <assert.h>
 #include <math.h>
+#include <stdlib.h>
 
-size_t tk_film_count(const double *times, size_t n, double every)
-{
-    if (n == 0 || !(every > 0.0) || !isfinite(every))
-        return 0;
-    double span = times[n - 1] - times[0];
-    return (size_t)floor(span / every) + 1;
-}
-
-void tk_film_picks(const double *times, size_t n, double every, size_t count, size_t *picks)
+size_t *tk_film_picks(const double *times, size_t n, size_t count, double every, size_t *out)
 {
     assert(n > 0);
+    double span = times[n - 1] - times[0];
+    if (every > 0.0 && isfinite(every)) {
+        double c = floor(span / every) + 1.0;
+        count = c <= TK_FILM_MOST ? (size_t)c : TK_FILM_MOST + 1;
+    } else
+        every = count > 1 ? span / (double)(count - 1) : 0.0;
+    *out = count;
+    size_t *picks = count <= TK_FILM_MOST ? malloc((count ? count : 1) * sizeof *picks) : NULL;
     size_t j = 0;
-    for (size_t k = 0; k < count; k++) {
+    for (size_t k = 0; picks && k < count; k++) {
         double t = times[0] + every * (double)k;
         while (j + 1 < n && times[j + 1] <= t)
             j++;
         picks[k] = j + 1 < n && times[j + 1] - t < t - times[j] ? j + 1 : j;
     }
+    return picks;
 }
 
 void tk_film_times(const long *steps, size_t n, const long *hsteps, const double *htimes,

@@ -9,16 +9,16 @@
 
 #include <stddef.h>
 
-/* How many film frames a time step of `every` gives from times[0] to
- * times[n - 1] (both ends included): 0 when n is 0 or every is not
- * positive and finite. */
-size_t tk_film_count(const double *times, size_t n, double every);
-
-/* For film frame k = 0 .. count - 1, at time times[0] + k every,
- * picks[k] is the index of the frame whose time is nearest (the earlier
- * on a tie); a frame repeats where the frames are sparser than the film's
- * step.  `times` ascending, n > 0. */
-void tk_film_picks(const double *times, size_t n, double every, size_t count, size_t *picks);
+/* The film's frames from n frames of ascending flow times (n > 0):
+ * `count` of them at equal steps from the first frame's time to the
+ * last's, or, with every > 0, one every `every` of flow time (the count
+ * following from the span).  For film frame k, at times[0] + k step, the
+ * index of the frame whose time is nearest (the earlier on a tie); a frame
+ * repeats where the frames are sparser than the film's step.  Returns the
+ * indices (malloc'd, *out their count), NULL when there would be more than
+ * TK_FILM_MOST or memory ran out. */
+#define TK_FILM_MOST 10000000
+size_t *tk_film_picks(const double *times, size_t n, size_t count, double every, size_t *out);
 
 /* The flow time at each of n frames' steps, read off a thinned history
  * (nh entries of step hsteps[i] and flow time htimes[i], steps

@@ -226,13 +226,7 @@ int tk_frames_main(int argc, char **argv)
     if (times) {
         for (size_t i = 0; i < n; i++)
             times[i] = s[i].flow_time;
-        double span = times[n - 1] - times[0], every = a.every_time;
-        count = every > 0.0 ? tk_film_count(times, n, every) : a.count;
-        if (!(every > 0.0))
-            every = span / (double)(count - 1);
-        picks = count <= 10000000 ? malloc(count * sizeof *picks) : NULL;
-        if (picks)
-            tk_film_picks(times, n, every, count, picks);
+        picks = tk_film_picks(times, n, a.count, a.every_time, &count);
     }
     if (status == FRAMES_OK && !picks) {
         fprintf(stderr, "tightknot frames: %zu frames: too many\n", count);

@@ -1059,15 +1059,10 @@ static int cmd_frames(client *c, const run_args *a, int argc, char **argv)
         for (size_t i = 0; i < n; i++)
             fsteps[i] = (long)json_integer_value(json_object_get(json_array_get(frames, i), "step"));
         tk_film_times(fsteps, n, hsteps, htimes, nh, times);
-        double every = a->every_time;
-        count = every > 0.0 ? tk_film_count(times, n, every) : a->count;
-        if (!(every > 0.0))
-            every = (times[n - 1] - times[0]) / (double)(count - 1);
-        picks = count <= 10000000 ? malloc(count * sizeof *picks) : NULL;
-        if (picks)
-            tk_film_picks(times, n, every, count, picks);
-        else
+        if (!(picks = tk_film_picks(times, n, a->count, a->every_time, &count))) {
+            fprintf(stderr, "tightknot remote frames: %zu frames: too many\n", count);
             status = REMOTE_FAILED;
+        }
     }
     if (status == REMOTE_OK && mkdir(a->out, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "tightknot remote: cannot make %s: %s\n", a->out, strerror(errno));
