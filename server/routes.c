@@ -266,7 +266,7 @@ static result get_history(tk_api *a, conn *c, const call *k)
         steps = thin;
     }
     return send_json(a, c, 200, json_pack("{s:I, s:I, s:o}", "id", tk_job_id(doc), "step",
-                                          (json_int_t)tk_job_step(doc), "steps", steps), NULL, NULL);
+                                          tk_store_step(a->store, doc), "steps", steps), NULL, NULL);
 }
 
 /* The job's curve (its input before the run starts), parsed to check it. */
@@ -302,7 +302,7 @@ static result get_vect(tk_api *a, conn *c, const call *k)
     const char *accept = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_ACCEPT);
     if (accept && strstr(accept, "application/json") && !strstr(accept, "text/plain")) {
         json_t *o = json_pack("{s:I, s:I, s:s%}", "id", tk_job_id(doc), "step",
-                              (json_int_t)tk_job_step(doc), "vect", text, len);
+                              tk_store_step(a->store, doc), "vect", text, len);
         free(text);
         return send_json(a, c, 200, o, NULL, NULL);
     }

@@ -203,6 +203,15 @@ int tk_store_get(tk_store *s, int64_t id, json_t **doc, tk_error *err)
     return rc;
 }
 
+json_int_t tk_store_step(tk_store *s, const json_t *doc)
+{
+    json_t *stored = NULL;
+    json_int_t step = (json_int_t)tk_job_step(
+        tk_store_get(s, tk_job_id(doc), &stored, NULL) == TK_OK ? stored : doc);
+    json_decref(stored);
+    return step;
+}
+
 int tk_store_part(tk_store *s, int64_t id, tk_part part, char **text, size_t *len, tk_error *err)
 {
     *text = NULL;

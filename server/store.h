@@ -86,6 +86,11 @@ int tk_store_put(tk_store *s, const json_t *doc, const char *const *parts,
  * went through this store since. */
 int tk_store_get(tk_store *s, int64_t id, json_t **doc, tk_error *err);
 
+/* The step of the job's parts as stored, written with its stored document
+ * in one transaction (a running job's live document, doc, is ahead of
+ * them); doc's own step when the store cannot say. */
+json_int_t tk_store_step(tk_store *s, const json_t *doc);
+
 /* One part; *text NULL when it was never stored (free with free()). */
 int tk_store_part(tk_store *s, int64_t id, tk_part part, char **text, size_t *len, tk_error *err);
 

@@ -26,6 +26,7 @@ const state = {
     job: null,
     contacts: null,
     curve: null,
+    shown: null,        // the stored step's report the figures show
     history: [],
     live: [],           // polled figures newer than the stored history
     frames: [],         // [{ step, comps }]
@@ -384,6 +385,7 @@ function selectJob(id) {
     state.job = null;
     state.contacts = null;
     state.curve = null;
+    state.shown = null;
     state.history = [];
     state.live = [];
     state.frames = [];
@@ -476,7 +478,6 @@ function showJob(job) {
     }
     const steps = job.options.steps;
     $('fig-step-label').textContent = steps ? `step of ${compact(steps)}` : 'step';
-    $('fig-step').textContent = `${job.progress.step}`;
     // The history is stored every few seconds; the polled figures fill the
     // chart in between.
     const lastStored = state.history.length ? state.history[state.history.length - 1].step : -1;
@@ -487,35 +488,50 @@ function showJob(job) {
             drawChart();
         }
     }
-    $('fig-ropelength').textContent = fixed(job.ropelength, 3);
-    $('fig-thickness').textContent = prec(job.thickness, 6);
-    $('fig-minrad').textContent = prec(job.minrad, 5);
-    $('fig-residual').textContent = sci(job.residual);
-    $('fig-struts').textContent = job.struts;
-    $('fig-kinks').textContent = job.kinks;
-    $('fig-vertices').textContent = job.vertices;
-    $('fig-seconds').textContent = job.seconds == null ? '–' : `${job.seconds.toFixed(1)} s`;
+    // until a step's curve and struts are shown, the polled figures
+    if (!state.shown) showFigures({ ...job, step: job.progress.step });
     showType(job.invariants);
     showBasins(job.basins);
     const frac = job.progress.fraction ?? (job.state === 'done' ? 1 : 0);
     $('job-progress').style.width = `${(100 * frac).toFixed(1)}%`;
 }
 
-// The curve and its struts of one step: a running job's worker may store
-// a newer step between the two requests, so they are asked again (a few
-// times at most) until both are of the same step.
+// The figures box: one step's report (a history entry, or the job's own
+// figures before any step is stored).
+function showFigures(r) {
+    $('fig-step').textContent = `${r.step}`;
+    $('fig-ropelength').textContent = fixed(r.ropelength, 3);
+    $('fig-thickness').textContent = prec(r.thickness, 6);
+    $('fig-minrad').textContent = prec(r.minrad, 5);
+    $('fig-residual').textContent = sci(r.residual);
+    $('fig-struts').textContent = r.struts;
+    $('fig-kinks').textContent = r.kinks;
+    $('fig-vertices').textContent = r.vertices;
+    $('fig-seconds').textContent = r.seconds == null ? '–' : `${r.seconds.toFixed(1)} s`;
+}
+
+// One step on the page: the figures, the 3-D view and the strut table
+// are of the same stored step.  A running job's worker may store a newer
+// step between the three requests, so they are asked again (a few times
+// at most) until the curve, the struts and the history's last entry agree.
 async function loadData(job, live) {
-    let doc, contacts, hist;
-    for (let tries = 0; tries < 4; tries++) {
+    let doc, contacts, hist, same = false;
+    for (let tries = 0; tries < 4 && !same; tries++) {
         [doc, contacts, hist] = await Promise.all([
             api.vect(job.id), api.struts(job.id), api.history(job.id, 1000),
         ]);
-        if (doc.step === contacts.step || !live()) break;
+        if (!live()) return;
+        const last = hist.steps[hist.steps.length - 1];
+        same = doc.step === contacts.step && last?.step === doc.step;
     }
     if (!live()) return;
     state.curve = { comps: parseVect(doc.vect), step: doc.step };
     state.contacts = contacts;
     state.history = hist.steps;
+    if (same) {
+        state.shown = hist.steps[hist.steps.length - 1];
+        showFigures(state.shown);
+    }
     const lastStored = hist.steps.length ? hist.steps[hist.steps.length - 1].step : -1;
     state.live = state.live.filter((s) => s.step > lastStored);
     drawChart();

@@ -68,7 +68,15 @@ describe('kill -9 and restart on the same store', () => {
         const b = await submit(d1, knot.text, { query: 'steps=150&name=b' });
         const c = await submit(d1, { vect: knot.text, name: 'c', options: { steps: 150 } });
         await waitJob(d1, a.id, (j) => j.state === 'running' && j.progress.step > 0);
-        await sleep(3000); // the store is written every 2 s
+        // the store is written every 2 s; its history is served from the
+        // store, so a stored step past the start shows there (a worker
+        // starved by a loaded machine, as under the thread sanitizer beside
+        // the page's suite, may write later than 2 s)
+        await sleep(3000);
+        for (let t0 = Date.now(); Date.now() - t0 < 30000; await sleep(200)) {
+            const h = (await d1.get(`/v1/jobs/${a.id}/history`)).json.steps;
+            if (h.length && h[h.length - 1].step > 0) break;
+        }
         const live = (await d1.get(`/v1/jobs/${a.id}`)).json;
         assert.equal(live.state, 'running');
         assert.equal((await d1.get(`/v1/jobs/${b.id}`)).json.state, 'queued');

@@ -411,6 +411,22 @@ test('a running job shows live figures and can be cancelled', async () => {
     // the chart follows the polled figures between stored histories
     await page.waitForFunction(() => (document.querySelector('#chart path.curve')?.getAttribute('d').match(/L/g) || []).length >= 2);
     await page.screenshot({ path: join(ARTIFACTS, 'running.png') });
+    // one step on the page: the figures, the 3-D view and the strut table
+    // name the same stored step, at every look while the job runs
+    const steps = () => page.evaluate(() => [
+        document.getElementById('fig-step').textContent,
+        /step (\d+)/.exec(document.getElementById('view3d-label').textContent)?.[1],
+        /at step (\d+)/.exec(document.getElementById('struts-caption').textContent)?.[1],
+    ].map(Number));
+    await page.waitForFunction(() => /at step/.test(document.getElementById('struts-caption').textContent));
+    const seen = new Set();
+    for (let k = 0; k < 12; k++) {
+        const [fig, view3d, table] = await steps();
+        assert.ok(fig === view3d && view3d === table, `figures at step ${fig}, 3-D view ${view3d}, struts ${table}`);
+        seen.add(fig);
+        await sleep(500);
+    }
+    assert.ok(seen.size >= 2, `the shown step moves on while the job runs: ${[...seen]}`);
     await page.click('#job-cancel');
     await page.waitForSelector('#job-state[data-state="cancelled"]', { timeout: 30000 });
     const job = await waitJob(id, ['cancelled']);
