@@ -51,7 +51,8 @@ export function webmType() {
 
 // Records `canvas` while show(k) draws film frame k, k = 0 .. count - 1,
 // `fps` a second, with the browser's own recorder; resolves to the WebM
-// blob.
+// blob.  The stream samples the canvas `fps` times a second, as the
+// frames are drawn: about one video frame each.
 export async function recordCanvas(canvas, count, fps, show) {
     const type = webmType();
     if (!type || !canvas.captureStream) throw new Error('this browser cannot record the view');
@@ -63,11 +64,20 @@ export async function recordCanvas(canvas, count, fps, show) {
         recorder.onstop = res;
         recorder.onerror = (e) => rej(e.error ?? new Error('the recorder failed'));
     });
+    const pause = () => new Promise((r) => setTimeout(r, 1000 / fps));
+    // frames drawn before the recorder has started, or after it was told to
+    // stop, are lost: it starts first (a recorder may wait for a first frame
+    // to start, so the first is drawn before; a second at most), and ends a
+    // frame's time after the last
+    const started = new Promise((r) => { recorder.onstart = r; });
+    show(0);
     recorder.start();
+    await Promise.race([started, new Promise((r) => setTimeout(r, 1000))]);
     for (let k = 0; k < count; k++) {
         show(k);
-        await new Promise((r) => setTimeout(r, 1000 / fps));
+        await pause();
     }
+    await pause();
     recorder.stop();
     await stopped;
     for (const t of stream.getTracks()) t.stop();

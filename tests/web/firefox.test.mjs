@@ -21,6 +21,7 @@ import { join } from 'node:path';
 import puppeteer from 'puppeteer-core';
 import { ARTIFACTS, sleep, startDaemon, api as daemonApi } from './daemon.mjs';
 import { canvasStatsInPage } from './canvas.mjs';
+import { readWebm } from './webm.mjs';
 
 const FIREFOX = process.env.TK_FIREFOX || '/usr/bin/firefox-esr';
 const XVFB = process.env.TK_XVFB || '/usr/bin/Xvfb';
@@ -199,6 +200,18 @@ test('Firefox: the view as PNG, the chart and map as SVG, the film as WebM', asy
     assert.ok(Buffer.from(film.bytes).includes(Buffer.from('webm')), 'of DocType webm');
     const shown = (await page.$eval('#export-film', (b) => b.dataset.steps)).split(' ').map(Number);
     assert.equal(shown.length, Math.min(200, Math.max(2, job.frames)));
+    const webm = readWebm(Uint8Array.from(film.bytes));
+    console.log(`Firefox film: ${webm.frames} frames over ${webm.durationMs} ms`);
+    assert.equal(webm.docType, 'webm');
+    // Firefox's stream samples the canvas less often than asked under
+    // software WebGL (12 to 14 video frames for 21 film frames here): a
+    // film of fewer frames, over the same time; at least 30% of them, and
+    // not more than one and a half times as many
+    assert.ok(webm.frames >= 0.3 * shown.length && webm.frames <= 1.5 * shown.length + 2,
+        `${webm.frames} video frames for ${shown.length} film frames`);
+    const nominal = (shown.length - 1) * 1000 / 25;
+    assert.ok(webm.durationMs >= 0.9 * nominal && webm.durationMs <= 4 * nominal,
+        `${webm.durationMs} ms for ${shown.length} frames at 25 a second (${nominal} ms)`);
 });
 
 test('Firefox: a bad VECT is rejected with the problem\'s detail and line', async () => {
