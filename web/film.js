@@ -51,8 +51,9 @@ export function webmType() {
 
 // Records `canvas` while show(k) draws film frame k, k = 0 .. count - 1,
 // `fps` a second, with the browser's own recorder; resolves to the WebM
-// blob.  The stream samples the canvas `fps` times a second, as the
-// frames are drawn: about one video frame each.
+// blob.  The stream samples the canvas `fps` times a second; each frame
+// stays on it a sample's time after it is shown: a video frame each, or
+// two where drawing took longer.
 export async function recordCanvas(canvas, count, fps, show) {
     const type = webmType();
     if (!type || !canvas.captureStream) throw new Error('this browser cannot record the view');
@@ -73,8 +74,13 @@ export async function recordCanvas(canvas, count, fps, show) {
     show(0);
     recorder.start();
     await Promise.race([started, new Promise((r) => setTimeout(r, 1000))]);
+    // each frame on the screen (two animation frames: drawn, then shown)
+    // before its time on the canvas starts, so that a loaded machine's
+    // compositor does not skip it
+    const shown = () => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
     for (let k = 0; k < count; k++) {
         show(k);
+        await shown();
         await pause();
     }
     await pause();

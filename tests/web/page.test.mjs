@@ -312,9 +312,10 @@ test('the film is a WebM of the run at equal flow time', async () => {
     const webm = readWebm(bytes);
     console.log(`film: ${webm.frames} frames over ${webm.durationMs} ms, ${bytes.length} bytes`);
     assert.equal(webm.docType, 'webm');
-    // about a video frame each: the stream samples the canvas 25 times a
-    // second as the page draws the film's frames 25 a second
-    assert.ok(Math.abs(webm.frames - shown.length) <= Math.max(3, 0.15 * shown.length),
+    // a video frame for each film frame, or two where drawing one took
+    // longer than a sample's time (the stream samples the canvas 25 times a
+    // second; each frame stays on it that long once shown)
+    assert.ok(webm.frames >= 0.9 * shown.length && webm.frames <= 2.5 * shown.length,
         `${webm.frames} video frames for ${shown.length} film frames`);
     const nominal = (shown.length - 1) * 1000 / 25;
     assert.ok(webm.durationMs >= 0.9 * nominal && webm.durationMs <= 4 * nominal,
@@ -431,7 +432,8 @@ test('a running job shows live figures and can be cancelled', async () => {
         /step (\d+)/.exec(document.getElementById('view3d-label').textContent)?.[1],
         /at step (\d+)/.exec(document.getElementById('struts-caption').textContent)?.[1],
     ].map(Number));
-    await page.waitForFunction(() => /at step/.test(document.getElementById('struts-caption').textContent));
+    // (once a step past the start is stored: before, only the input is)
+    await page.waitForFunction(() => /at step [1-9]/.test(document.getElementById('struts-caption').textContent));
     const seen = new Set();
     for (let k = 0; k < 12; k++) {
         const [fig, view3d, table] = await steps();
