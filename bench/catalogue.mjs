@@ -248,7 +248,9 @@ function readRows(path, dir, rows) {
 
 function kinksOf(start, dir) {
     try {
-        const doc = JSON.parse(readFileSync(join(dir, `${start}.struts.json`), 'utf8'));
+        // NAME-struts.json (NAME.struts.json from older clients)
+        const file = [`${start}-struts.json`, `${start}.struts.json`].map((f) => join(dir, f)).find(existsSync);
+        const doc = JSON.parse(readFileSync(file ?? join(dir, `${start}-struts.json`), 'utf8'));
         return doc.kinks?.length ?? '';
     } catch {
         return '';

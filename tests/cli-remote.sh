@@ -104,7 +104,7 @@ while IFS="	" read -r name comps verts rope thick resid struts steps secs reache
     info_rope=$(sed -n 's/.*"ropelength":\([^,}]*\).*/\1/p' "$tmp/info.json")
     awk -v a="$info_rope" -v b="$rope" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= 1e-9 * b) }'
     check $? "$name: tightknot info on the download gives $info_rope, the job $rope"
-    grep -q '"struts":\[' "$tmp/out/$name.struts.json"
+    grep -q '"struts":\[' "$tmp/out/$name-struts.json"
     check $? "$name: struts JSON downloaded"
 done <"$tmp/rows"
 
@@ -140,8 +140,9 @@ check $? "status exits 0"
 grep -q "^$first	.*	done	step 60	" "$tmp/status"
 check $? "status line: $(cat "$tmp/status")"
 "$tk" remote --server "$url" fetch --out "$tmp/fetched" "$first" >/dev/null 2>&1 &&
-    cmp -s "$tmp/fetched/job-$first.vect" "$tmp/out/trefoil.vect"
-check $? "fetch downloads the same VECT"
+    cmp -s "$tmp/fetched/trefoil-$first.vect" "$tmp/out/trefoil.vect" &&
+    cmp -s "$tmp/fetched/trefoil-$first-struts.json" "$tmp/out/trefoil-struts.json"
+check $? "fetch downloads the same VECT and struts, named NAME-JOB as the page names them"
 "$tk" remote --server "$url" cancel "$first" >/dev/null 2>"$tmp/cancel"
 [ $? -eq 2 ] && grep -q "already finished" "$tmp/cancel"
 check $? "cancelling a finished job: $(cat "$tmp/cancel")"

@@ -43,7 +43,7 @@ const char tk_remote_help[] =
     "      tighten every VECT file (a directory stands for its *.vect files):\n"
     "      submits them, at most N running at once (default 4), shows their\n"
     "      progress, and downloads each result into DIR (default\n"
-    "      tightknot-results): NAME.vect (the tight curve), NAME.struts.json\n"
+    "      tightknot-results): NAME.vect (the tight curve), NAME-struts.json\n"
     "      (struts and kinks) and a row of DIR/summary.tsv with name,\n"
     "      components, vertices, ropelength, thickness, residual, struts, steps,\n"
     "      seconds, reached (how many of the run's tightenings reached its\n"
@@ -56,7 +56,8 @@ const char tk_remote_help[] =
     "  cancel JOB...   cancel queued or running jobs\n"
     "  delete JOB...   delete finished jobs (done, failed or cancelled) from\n"
     "                  the server, with their results\n"
-    "  fetch [--out DIR] JOB...   download jobs' VECT and struts into DIR\n"    "  frames [--count N | --every-time T] [--out DIR] JOB\n"
+    "  fetch [--out DIR] JOB...   download jobs' VECT and struts into DIR\n"
+    "                  (NAME-JOB.vect and NAME-JOB-struts.json, as the page)\n"    "  frames [--count N | --every-time T] [--out DIR] JOB\n"
     "      a film's frames at equal flow time from the job's stored frames\n"
     "      (N of them, default 200, or one every T of flow time, each\n"
     "      frame's flow time read off the job's stored steps): DIR/NAME-JOB-\n"
@@ -525,7 +526,7 @@ static bool download(client *c, long long job, const char *out, const char *name
     if (ok)
         ok = request(c, "GET", api, NULL, NULL, 0, &r) && r.status == 200;
     if (ok) {
-        snprintf(path, sizeof path, "%s/%s.struts.json", out, name);
+        snprintf(path, sizeof path, "%s/%s-struts.json", out, name);
         ok = write_file(path, r.body.data, r.body.len);
     }
     free(r.body.data);
@@ -951,6 +952,18 @@ static int cmd_list(client *c, bool json, int argc, char **argv)
     return status;
 }
 
+/* A job's files are named NAME-JOB..., as the page names them: its name
+ * with what a file name cannot hold as '_'. */
+static void file_base(char *out, size_t size, const json_t *job, long long id)
+{
+    char name[256];
+    printable(name, sizeof name, json_string_value(json_object_get(job, "name")));
+    for (char *p = name; *p; p++)
+        if (!(isalnum((unsigned char)*p) || *p == '.' || *p == '_' || *p == '-'))
+            *p = '_';
+    snprintf(out, size, "%s-%lld", name, id);
+}
+
 /* GET path as JSON into *out (NULL on failure, said on stderr). */
 static int get_json(client *c, const char *path, json_t **out)
 {
@@ -1068,16 +1081,12 @@ static int cmd_frames(client *c, const run_args *a, int argc, char **argv)
         fprintf(stderr, "tightknot remote: cannot make %s: %s\n", a->out, strerror(errno));
         status = REMOTE_FAILED;
     }
-    /* NAME-JOB-frame-KKKK.vect, the name's characters kept to a file's */
-    printable(name, sizeof name, json_string_value(json_object_get(job, "name")));
-    for (char *p = name; *p; p++)
-        if (!(isalnum((unsigned char)*p) || *p == '.' || *p == '_' || *p == '-'))
-            *p = '_';
+    file_base(name, sizeof name, job, id);
     if (status == REMOTE_OK)
         printf("frame\tstep\tflow_time\tfile\n");
     for (size_t k = 0; status == REMOTE_OK && k < count; k++) {
         char file[4400];
-        snprintf(file, sizeof file, "%s/%s-%lld-frame-%04zu.vect", a->out, name, id, k + 1);
+        snprintf(file, sizeof file, "%s/%s-frame-%04zu.vect", a->out, name, k + 1);
         if (!write_frame(file, json_array_get(frames, picks[k]))) {
             fprintf(stderr, "tightknot remote: cannot write %s\n", file);
             status = REMOTE_FAILED;
@@ -1159,12 +1168,12 @@ static int cmd_jobs(client *c, const char *what, const run_args *a, bool json, i
         if (json && !cancel) {
             printf("%s\n", r.body.data);
         } else if (!strcmp(what, "fetch")) {
-            char file[64];
-            snprintf(file, sizeof file, "job-%lld", id);
+            char file[300];
+            file_base(file, sizeof file, job, id);
             if (!download(c, id, a->out, file))
                 status = REMOTE_FAILED;
             else
-                printf("job %lld (%s): %s/%s.vect, %s/%s.struts.json\n", id, name,
+                printf("job %lld (%s): %s/%s.vect, %s/%s-struts.json\n", id, name,
                        a->out, file, a->out, file);
         } else {
             print_job(id, job, cancel ? (r.status == 202 ? "cancelling" : "cancelled") : NULL);
