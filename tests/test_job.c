@@ -1,5 +1,5 @@
 /* Tests for the job document (server/job.c): its options by name from
- * text and from JSON, their domains, the default step limit, the round
+ * text and from JSON, their domains, the defaults that tighten, the round
  * trip through the document, and the document's figures against the
  * step report they come from. */
 #include <check.h>
