@@ -1019,6 +1019,19 @@ static void stops_text(const tk_options *o, char *buf, size_t n)
 #undef STOP_PART
 }
 
+/* What a run was given, in words: "resolution 5, autoscale, stops when
+ * converged or after 120 s (--time)". */
+static void settings_text(const tk_options *o, char *buf, size_t n)
+{
+    char stops[160], count[64] = "";
+    stops_text(o, stops, sizeof stops);
+    if (o->resolution > 0.0)
+        snprintf(count, sizeof count, "resolution %g, ", o->resolution);
+    else if (o->vertices > 0)
+        snprintf(count, sizeof count, "%zu vertices, ", o->vertices);
+    snprintf(buf, n, "%s%sstops %s", count, o->autoscale ? "autoscale, " : "", stops);
+}
+
 static void print_progress(tighten_watch *w, const tk_step_report *s)
 {
     char budget[96], residual[32] = "-";
@@ -1191,16 +1204,10 @@ static int cmd_tighten(int argc, char **argv)
         goto done;
     }
     w.run = run;
-    char stops[160];
-    stops_text(&run_opts, stops, sizeof stops);
-    if (w.terminal || w.plain) {
-        fprintf(stderr, "tightknot: tightening %s", name);
-        if (run_opts.resolution > 0.0)
-            fprintf(stderr, " at resolution %g", run_opts.resolution);
-        else if (run_opts.vertices > 0)
-            fprintf(stderr, " on %zu vertices", run_opts.vertices);
-        fprintf(stderr, "; it stops %s\n", stops);
-    }
+    char settings[256];
+    settings_text(&run_opts, settings, sizeof settings);
+    if (w.terminal || w.plain)
+        fprintf(stderr, "tightknot: tightening %s: %s\n", name, settings);
     tighten_progress(tk_run_latest(run), &w);
     tk_run_set_progress(run, tighten_progress, &w);
     tk_stop_reason why = TK_STOP_NONE;
@@ -1297,12 +1304,7 @@ static int cmd_tighten(int argc, char **argv)
                 printf("reached %.9g%s\n", e[k].reached, e[k].improved ? " (better)" : "");
         }
         print_basins(tk_json_basins(e, ne, last->ropelength));
-        printf("  settings: ");
-        if (run_opts.resolution > 0.0)
-            printf("resolution %g, ", run_opts.resolution);
-        else if (run_opts.vertices > 0)
-            printf("%zu vertices, ", run_opts.vertices);
-        printf("%sstops %s\n", run_opts.autoscale ? "autoscale, " : "", stops);
+        printf("  settings: %s\n", settings);
     }
 done:
     if (w.log && fclose(w.log) != 0) {
