@@ -17,7 +17,7 @@ import { join } from 'node:path';
 import { chromium } from 'playwright-core';
 import { ARTIFACTS, sleep, startDaemon, api as daemonApi } from './daemon.mjs';
 import { canvasStatsInPage } from './canvas.mjs';
-import { readWebm } from './webm.mjs';
+import { assertFilm } from './webm.mjs';
 
 const CHROMIUM = process.env.TK_CHROMIUM || '/usr/bin/chromium';
 
@@ -307,19 +307,7 @@ test('the film is a WebM of the run at equal flow time', async () => {
     assert.ok(bytes.includes(Buffer.from('webm')), 'of DocType webm');
     assert.ok(bytes.length > 2000, `${bytes.length} bytes`);
     const shown = (await page.getAttribute('#export-film', 'data-steps')).split(' ').map(Number);
-    // the recorder stamps the frames in real time: a loaded machine may
-    // space them wider than 25 a second
-    const webm = readWebm(bytes);
-    console.log(`film: ${webm.frames} frames over ${webm.durationMs} ms, ${bytes.length} bytes`);
-    assert.equal(webm.docType, 'webm');
-    // a video frame for each film frame, or two where drawing one took
-    // longer than a sample's time (the stream samples the canvas 25 times a
-    // second; each frame stays on it that long once shown)
-    assert.ok(webm.frames >= 0.9 * shown.length && webm.frames <= 2.5 * shown.length,
-        `${webm.frames} video frames for ${shown.length} film frames`);
-    const nominal = (shown.length - 1) * 1000 / 25;
-    assert.ok(webm.durationMs >= 0.9 * nominal && webm.durationMs <= 4 * nominal,
-        `${webm.durationMs} ms for ${shown.length} frames at 25 a second (${nominal} ms)`);
+    assertFilm(bytes, shown.length, 25, 'film');
     const { body: fr } = await api(`/v1/jobs/${id}/frames?limit=200`);
     const frameTimes = fr.frames.map((f) => flow.get(f.step));
     assert.equal(shown.length, Math.min(200, Math.max(2, fr.frames.length)));

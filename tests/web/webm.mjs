@@ -3,6 +3,8 @@
 // first frame to the last, so that a film's frame count and duration can
 // be checked without a decoder.
 
+import assert from 'node:assert/strict';
+
 const SEGMENT = 0x18538067, CLUSTER = 0x1f43b675, BLOCK_GROUP = 0xa0, INFO = 0x1549a966;
 const TIMECODE = 0xe7, TIMECODE_SCALE = 0x2ad7b1, SIMPLE_BLOCK = 0xa3, BLOCK = 0xa1;
 const DOC_TYPE = 0x4282;
@@ -50,4 +52,21 @@ export function readWebm(bytes) {
         at = body + size.value;
     }
     return { docType, frames, firstMs: first, lastMs: last, durationMs: last - first };
+}
+
+// A film of `count` frames at `fps` a second, as the page records it: a
+// WebM with a video frame for each film frame, or two where drawing one
+// took longer than a sample's time (the stream samples the canvas `fps`
+// times a second; each frame stays on it that long once shown), over at
+// least 0.9 of the nominal time (the recorder stamps frames in real time:
+// a loaded machine may space them wider, up to 4 times here).
+export function assertFilm(bytes, count, fps, what) {
+    const webm = readWebm(bytes);
+    console.log(`${what}: ${webm.frames} video frames over ${webm.durationMs} ms for ${count} film frames`);
+    assert.equal(webm.docType, 'webm');
+    assert.ok(webm.frames >= 0.9 * count && webm.frames <= 2.5 * count,
+        `${webm.frames} video frames for ${count} film frames`);
+    const nominal = (count - 1) * 1000 / fps;
+    assert.ok(webm.durationMs >= 0.9 * nominal && webm.durationMs <= 4 * nominal,
+        `${webm.durationMs} ms for ${count} frames at ${fps} a second (${nominal} ms)`);
 }
