@@ -34,10 +34,9 @@ int tk_job_options_from_json(tk_job_options *o, const json_t *obj, const char **
     int rc = tk_json_record_set(tk_job_option_fields, tk_job_option_nfields, o, obj, bad, err);
     const char *name;
     json_t *value;
-    json_object_foreach((json_t *)obj, name, value) {
-        if (!rc)
+    if (!rc)
+        json_object_foreach((json_t *)obj, name, value)
             (void)tk_options_given_mark(&o->given, name); /* false for every */
-    }
     return rc;
 }
 

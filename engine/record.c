@@ -123,12 +123,6 @@ int tk_options_check(const tk_options *o, tk_error *err)
     return TK_OK;
 }
 
-bool tk_options_have_stop(const tk_options *o)
-{
-    return o->max_steps > 0 || o->max_seconds > 0.0 || o->min_residual > 0.0 ||
-           o->min_change > 0.0 || o->converge;
-}
-
 double tk_options_spent(const tk_options *o, const tk_step_report *s)
 {
     double spent = -1.0;

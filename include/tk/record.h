@@ -73,10 +73,6 @@ int tk_field_parse(const tk_field *f, void *record, const char *text, tk_error *
  * other (re_resolve and snapshots exclude each other). */
 int tk_options_check(const tk_options *o, tk_error *err);
 
-/* Whether some stop criterion is set (steps, time, residual, change,
- * converge). */
-bool tk_options_have_stop(const tk_options *o);
-
 /* The share of its budget (steps, time: the larger share) a run has
  * spent at the step report s, not capped at 1; -1 when it has no budget. */
 double tk_options_spent(const tk_options *o, const tk_step_report *s);
