@@ -32,7 +32,9 @@
 //                     OUT/jobs.db, one worker per core)
 //   --token TOKEN     for a daemon with --tokens
 //   --slice K/N       the K-th of N slices (default 1/1: all)
-//   --seconds S       wall time per start (default 60)
+//   --seconds S       processor time per start (default 60): each job's
+//                     own (cpu_time), so that a slice run beside other
+//                     work gives each start what it gets on an idle machine
 //   --resolution R    vertices per unit ropelength (default 5)
 //   --far K           far starts per knot (generate wander), seeds 1..K (default 1)
 //   --turn K          turned starts per knot, seeds 0..K-1 (default 1)
@@ -214,7 +216,7 @@ async function submitAll(server, files) {
     // autoscale: a deformed start is thinner than the tube (ropelength
     // does not depend on the scale)
     const args = ['remote', '--server', server, 'submit', '--resolution', String(opt.resolution),
-        '--time', String(opt.seconds), '--autoscale', '--parallel', String(opt.parallel),
+        '--time', String(opt.seconds), '--cpu-time', '--autoscale', '--parallel', String(opt.parallel),
         '--out', resultsDir, ...files];
     if (opt.token) args.splice(3, 0, '--token', opt.token);
     const child = spawn(CLI, args, { stdio: 'inherit' });
@@ -269,7 +271,9 @@ function writeTable() {
         if (!byKnot.has(knot)) byKnot.set(knot, []);
         byKnot.get(knot).push({ ...r, tag: r.name.slice(at + 1) });
     }
-    const settings = `resolution ${opt.resolution}, ${opt.seconds} s a start, autoscale, default escapes`;
+    // (slices run before cpu_time ran alone on the machine, where the wall
+    // clock and the processor's agree)
+    const settings = `resolution ${opt.resolution}, ${opt.seconds} s of processor time a start, autoscale, default escapes`;
     const lines = [['name', 'components', 'type', 'vertices', 'starts', 'lowest', 'lowest.start',
         'spread.%', 'cat.above.%', 'lowest.reached', 'struts', 'kinks', 'seconds', 'failed', 'type.changed',
         'unconverged', 'settings'].join('\t')];

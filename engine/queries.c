@@ -64,6 +64,30 @@ double tk_clock(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+static double thread_clock(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+double tk_run_clock(const tk_run *r)
+{
+    if (!r->opt.cpu_time)
+        return tk_clock() - r->life.started;
+    return r->life.cpu_spent + (thread_clock() - r->life.cpu_entered);
+}
+
+void tk_run_clock_enter(tk_run *r)
+{
+    r->life.cpu_entered = thread_clock();
+}
+
+void tk_run_clock_leave(tk_run *r)
+{
+    r->life.cpu_spent += thread_clock() - r->life.cpu_entered;
+}
+
 bool tk_history_fall(const tk_run *r, size_t from, size_t window, double *fall)
 {
     size_t n = r->life.nhistory;

@@ -237,7 +237,9 @@ struct tk_run {
         double *snapshots;
         long *snapshot_steps;
         size_t nsnapshots, snapshot_capacity;
-        double started;
+        double started;   /* tk_clock() at the start, less a resumed run's seconds */
+        double cpu_spent; /* with cpu_time: the run's processor seconds before this call */
+        double cpu_entered; /* the thread's processor clock where this call began */
         double flow_from; /* the flow's time at the start (a resumed run's) */
         tk_stop_reason stop;
         atomic_int cancel;
@@ -284,6 +286,15 @@ static inline double tk_norm(const double *v, size_t n)
 
 /* Monotonic wall time in seconds, for the timing figures. */
 double tk_clock(void);
+
+/* The run's own clock, whose seconds its reports give and its time
+ * budget counts: the wall clock since the start, or with cpu_time the
+ * processor time of the threads that ran it, summed over the calls into
+ * the run (tk_run_clock_enter and _leave bracket each, on its thread; a
+ * run can be driven by one thread and then another). */
+double tk_run_clock(const tk_run *r);
+void tk_run_clock_enter(tk_run *r);
+void tk_run_clock_leave(tk_run *r);
 
 /* How much the ropelength fell over the last `window` entries of the
  * history, relative: the lowest over them below the lowest over the

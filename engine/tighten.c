@@ -61,7 +61,7 @@ static int record(tk_run *r, tk_step_report *rep, tk_error *err)
     rep->vertices = r->shared.curve->nvert;
     rep->escapes = tk_escape_tries(r);
     rep->restarts = r->schedule.restarts;
-    rep->seconds = tk_clock() - r->life.started;
+    rep->seconds = tk_run_clock(r);
     /* the step sizes of the history summed: a step put back in the place
      * of the last (record_restored) has size 0 and the time of the one
      * before it */
@@ -144,6 +144,8 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
     atomic_init(&r->life.cancel, 0);
     /* a resumed run's clock goes on from the time it had spent */
     r->life.started = tk_clock() - (at ? at->seconds : 0.0);
+    r->life.cpu_spent = at ? at->seconds : 0.0;
+    tk_run_clock_enter(r);
     r->life.flow_from = at ? at->flow_time : 0.0;
     tk_escape_start(r, at != NULL);
     rc = tk_nnls_new(&r->shared.nnls, err);
@@ -182,6 +184,7 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
     }
     tk_stepping_resume(r, at ? at->step_size : 0.0);
     r->life.seconds = tk_clock() - r->life.started;
+    tk_run_clock_leave(r);
     *out = r;
     return TK_OK;
 }
@@ -316,7 +319,9 @@ static int step(tk_run *r, tk_error *err);
 int tk_run_step(tk_run *r, tk_error *err)
 {
     double t0 = tk_clock();
+    tk_run_clock_enter(r);
     int rc = step(r, err);
+    tk_run_clock_leave(r);
     r->life.seconds += tk_clock() - t0;
     return rc;
 }
@@ -366,7 +371,9 @@ int tk_run_until(tk_run *r, tk_stop_reason *reason, tk_error *err)
         r->life.stop = TK_STOP_NONE;
     check_stop(r);
     double t0 = tk_clock();
+    tk_run_clock_enter(r);
     rc = check_result(r, err);
+    tk_run_clock_leave(r);
     r->life.seconds += tk_clock() - t0;
     while (!rc && r->life.stop == TK_STOP_NONE) {
         rc = tk_run_step(r, err);

@@ -1427,6 +1427,76 @@ START_TEST(timing_accounts_for_the_run)
 }
 END_TEST
 
+/* Sleeps SLEEP_MS after every step: wall time the run's thread spends
+ * without its processor. */
+#define SLEEP_MS 3
+static int sleep_step(const tk_step_report *s, void *user)
+{
+    (void)s;
+    (*(long *)user)++;
+    nanosleep(&(struct timespec){0, SLEEP_MS * 1000000L}, NULL);
+    return 0;
+}
+
+/* A time budget on the run's own processor time: with cpu_time the
+ * seconds the run reports and stops at leave out the wall time its thread
+ * slept (a busy machine's other work), and a resumed run goes on from the
+ * seconds it had spent; without it they are the wall clock's.  Measured
+ * against the wall clock outside the run and the sleeps counted. */
+START_TEST(cpu_time_counts_the_run_s_own_processor_time)
+{
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_chain(3, 48, &c, NULL), TK_OK);
+    const double budget = 0.3;
+    for (int cpu = 0; cpu <= 1; cpu++) {
+        tk_options o = TK_OPTIONS_INIT;
+        o.autoscale = true;
+        o.max_seconds = budget;
+        o.cpu_time = cpu;
+        long steps = 0;
+        double t0 = wall_seconds();
+        tk_run *run = NULL;
+        ck_assert_int_eq(tk_run_new(c, &o, &run, NULL), TK_OK);
+        tk_run_set_progress(run, sleep_step, &steps);
+        tk_stop_reason why;
+        ck_assert_int_eq(tk_run_until(run, &why, NULL), TK_OK);
+        double wall = wall_seconds() - t0, slept = 1e-3 * SLEEP_MS * (double)steps;
+        const tk_step_report *s = tk_run_latest(run);
+        printf("cpu_time %d: stopped at %.3f s reported, %.3f s of wall time, %.3f s slept, "
+               "%ld steps\n", cpu, s->seconds, wall, slept, steps);
+        ck_assert_int_eq(why, TK_STOP_TIME);
+        ck_assert(s->seconds >= budget);
+        if (cpu) {
+            /* the sleeps are not counted: the run took its budget besides them */
+            ck_assert(wall >= budget + slept);
+            ck_assert(s->seconds <= wall - slept + 0.05);
+            /* resumed, it goes on from its seconds and spends the rest */
+            tk_resume at;
+            tk_run_resume_point(run, &at);
+            ck_assert(at.seconds == s->seconds);
+            tk_run *again = NULL;
+            tk_options more = o;
+            more.max_seconds = s->seconds + 0.1;
+            ck_assert_int_eq(tk_run_resume(tk_run_curve(run), &more, &at, NULL, NULL,
+                                           tk_run_type_start(run), &again, NULL),
+                             TK_OK);
+            ck_assert(tk_run_latest(again)->seconds >= s->seconds);
+            ck_assert(tk_run_latest(again)->seconds < s->seconds + 0.05);
+            ck_assert_int_eq(tk_run_until(again, &why, NULL), TK_OK);
+            ck_assert_int_eq(why, TK_STOP_TIME);
+            ck_assert(tk_run_latest(again)->seconds >= more.max_seconds);
+            tk_run_free(&again);
+        } else {
+            /* the wall clock counts them: the run stopped within its budget of wall time */
+            ck_assert(s->seconds <= wall);
+            ck_assert(wall < budget + 0.1);
+        }
+        tk_run_free(&run);
+    }
+    tk_curve_free(&c);
+}
+END_TEST
+
 /* The type is checked where the flow's constraints do not hold it: a
  * trefoil resampled to 4 vertices is an unknot, and the run is refused
  * with the reason; a run that keeps its type reports it, start and
@@ -2508,6 +2578,7 @@ int main(void)
     tcase_add_test(tc, corrected_steps_report_their_forces);
     tcase_add_test(tc, history_and_snapshots);
     tcase_add_test(tc, timing_accounts_for_the_run);
+    tcase_add_test(tc, cpu_time_counts_the_run_s_own_processor_time);
     tcase_add_test(tc, the_knot_type_is_checked);
     tcase_add_test(tc, escapes_keep_the_best_and_repeat);
     tcase_add_test(tc, a_resumed_run_goes_on_where_it_was);

@@ -92,6 +92,9 @@
     X(max_steps, LONG, 0, 0, 1e8, "steps", "stop after this many steps (0: no limit)")       \
     X(max_seconds, REAL, 0.0, 0.0, 604800, "time",                                           \
       "stop after this many seconds, at most a week (0: no limit)")                          \
+    X(cpu_time, BOOL, false, 0, 1, "cpu_time",                                               \
+      "count the seconds (--time, and those reported) in the run's own processor time, not " \
+      "the wall clock's: on a busy machine a run then does the work it does on an idle one") \
     X(min_residual, REAL, 0.0, 0.0, 1.0, "residual",                                         \
       "stop when the residual |resolved gradient| / |gradient| falls below this (0: "        \
       "never)")                                                                              \
