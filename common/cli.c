@@ -28,6 +28,16 @@ void tk_cli_flag(tk_cli *c, const char *name, int letter, bool *out, const char 
     add(c, name, letter, NULL, help)->flag = out;
 }
 
+void tk_cli_texts(tk_cli *c, const char *name, const char *arg, const char **out, size_t most,
+                  size_t *count, const char *help)
+{
+    tk_cli_option *o = add(c, name, 0, arg, help);
+    o->texts = out;
+    o->count = count;
+    o->most = most;
+    *count = 0;
+}
+
 void tk_cli_fields(tk_cli *c, const tk_field *table, size_t n, void *record)
 {
     for (size_t k = 0; k < n; k++) {
@@ -63,6 +73,12 @@ static int apply(const tk_cli_option *o, const char *value, tk_error *err)
         *o->flag = true;
     if (o->text)
         *o->text = value;
+    if (o->texts) {
+        if (*o->count == o->most)
+            return tk_error_set(err, TK_EINVAL, "--%s: given more than %zu times", o->name,
+                                o->most);
+        o->texts[(*o->count)++] = value;
+    }
     if (!o->field)
         return TK_OK;
     tk_error why;

@@ -25,6 +25,8 @@ typedef struct tk_cli_option {
     const char *arg;       /* the value's name in --help; NULL: takes none */
     const char *help;
     const char **text;     /* a text option's value (pointing into argv) */
+    const char **texts;    /* a repeated text option's values, *count of at most most */
+    size_t *count, most;
     bool *flag;            /* a flag, set when given */
     const tk_field *field; /* a field of `record`, set with its domain */
     void *record;
@@ -43,6 +45,10 @@ typedef struct tk_cli {
 void tk_cli_text(tk_cli *c, const char *name, int letter, const char *arg, const char **out,
                  const char *help);
 void tk_cli_flag(tk_cli *c, const char *name, int letter, bool *out, const char *help);
+/* A text option that may be given again and again: its values in order
+ * at out[0 .. *count), at most `most` of them. */
+void tk_cli_texts(tk_cli *c, const char *name, const char *arg, const char **out, size_t most,
+                  size_t *count, const char *help);
 void tk_cli_fields(tk_cli *c, const tk_field *table, size_t n, void *record);
 
 /* Sets every field of a table to its default. */

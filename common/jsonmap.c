@@ -177,7 +177,8 @@ static double *edge_starts(const tk_curve *c, double *comp_start)
 }
 
 json_t *tk_json_contacts(const tk_curve *c, const tk_strut *struts, size_t nstruts,
-                         const tk_kink *kinks, size_t nkinks, bool with_force)
+                         const tk_kink *kinks, size_t nkinks, bool with_force,
+                         const double *pin_force)
 {
     double *comp_start = malloc((c->ncomp + 1) * sizeof *comp_start);
     double *start = comp_start ? edge_starts(c, comp_start) : NULL;
@@ -247,6 +248,26 @@ json_t *tk_json_contacts(const tk_curve *c, const tk_strut *struts, size_t nstru
     json_object_set_new(o, "components", comps);
     json_object_set_new(o, "struts", list);
     json_object_set_new(o, "kinks", klist);
+    if (c->npins) {
+        json_t *plist = json_array();
+        for (size_t i = 0; i < c->npins; i++) {
+            const tk_pin *p = &c->pins[i];
+            char text[512];
+            tk_pin_format(p, text, sizeof text);
+            /* the vertex's place along the components, as a kink's */
+            size_t e = tk_curve_comp_first_edge(c, p->comp) + p->vertex;
+            double along = p->vertex < tk_curve_comp_edges(c, p->comp)
+                               ? start[e]
+                               : comp_start[p->comp] + tk_curve_comp_length(c, p->comp);
+            json_t *j = json_pack("{s:I, s:I, s:s, s:o}", "comp", (json_int_t)p->comp, "vertex",
+                                  (json_int_t)p->vertex, "constraint", text, "arclength",
+                                  tk_json_number(along));
+            if (with_force && pin_force)
+                json_object_set_new(j, "force", tk_json_number(pin_force[i]));
+            json_array_append_new(plist, j);
+        }
+        json_object_set_new(o, "constraints", plist);
+    }
     free(start);
     free(comp_start);
     return o;

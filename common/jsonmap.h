@@ -64,12 +64,16 @@ json_t *tk_json_basins(const tk_escape *e, size_t count, double final);
  *   {"components": [{"vertices", "closed", "length", "start"}],
  *    "struts": [{"edges": [[comp, edge], [comp, edge]], "s", "t", "p", "q",
  *                "length", "arclength": [a, b], "force"}],
- *    "kinks": [{"comp", "vertex", "minrad", "arclength", "force"}]}
+ *    "kinks": [{"comp", "vertex", "minrad", "arclength", "force"}],
+ *    "constraints": [{"comp", "vertex", "constraint", "arclength", "force"}]}
  * "arclength" is the position along the components laid end to end in
  * order ("start" is where each component begins), the coordinates of the
- * contact map.  Forces are included only when with_force. */
+ * contact map.  Forces are included only when with_force; "constraints"
+ * (the curve's pins, "constraint" as --constrain writes it) only when the
+ * curve has some, their forces from pin_force (tk_run_pin_forces). */
 json_t *tk_json_contacts(const tk_curve *c, const tk_strut *struts, size_t nstruts,
-                         const tk_kink *kinks, size_t nkinks, bool with_force);
+                         const tk_kink *kinks, size_t nkinks, bool with_force,
+                         const double *pin_force);
 
 /* The knot or link type of a curve (tk/invariants.h):
  *   {"alexander": [[1, -1, 1], ...], "alexander_text": ["1 - t + t^2", ...],

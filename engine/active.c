@@ -1,6 +1,7 @@
 /* The active set: which struts and kinks hold the motion, the rigidity
  * matrix of a set, and the forces kept from one step for the next (the
  * warm start).  See run.h for the rooms of the flow. */
+#include <assert.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -221,8 +222,11 @@ int tk_active_expand(tk_run *r, const tk_curve *trial, size_t *added, tk_error *
     return rc;
 }
 
-/* The rows of fixed vertices are zeroed: those coordinates are not
- * variables. */
+/* The rows of pinned vertices are projected onto the directions their
+ * constraints allow (zeroed for a point): the other directions are not
+ * variables.  Projecting the columns and the gradient (motion.c) solves
+ * min |P (A x + u)|, the problem with the constraints' own multipliers
+ * eliminated. */
 int tk_active_matrix(tk_run *r, const tk_curve *c, const tk_constraints *set,
                      cholmod_sparse **a, tk_error *err)
 {
@@ -231,11 +235,18 @@ int tk_active_matrix(tk_run *r, const tk_curve *c, const tk_constraints *set,
                                         set->kink_edge, set->nkinks,
                                         tk_nnls_common(r->shared.nnls), a, err);
     if (!rc) {
+        /* a column's rows come sorted, three for each of its vertices
+         * (tk_rigidity_build_branches) */
         const int *colp = (*a)->p, *row = (*a)->i;
         double *val = (*a)->x;
-        for (int k = 0; k < colp[(*a)->ncol]; k++)
-            if (r->shared.fixed[row[k] / 3])
-                val[k] = 0.0;
+        for (int k = 0; k + 2 < colp[(*a)->ncol]; k++) {
+            const tk_pin *pin = r->shared.pin[row[k] / 3];
+            if (!pin)
+                continue;
+            assert(row[k] % 3 == 0 && row[k + 2] == row[k] + 2);
+            tk_pin_project(pin, val + k);
+            k += 2;
+        }
     }
     r->active.matrix_seconds += tk_clock() - t0;
     return rc;

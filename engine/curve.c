@@ -47,6 +47,7 @@ void tk_curve_free(tk_curve **p)
     free(c->closed);
     free(c->xyz);
     free(c->colour);
+    free(c->pins);
     free(c);
     *p = NULL;
 }
@@ -72,6 +73,43 @@ int tk_curve_copy(const tk_curve *src, tk_curve **out, tk_error *err)
         memcpy((*out)->colour, src->colour, 4 * src->ncomp * sizeof *src->colour);
         (*out)->has_colour = true;
     }
+    if (src->npins) {
+        (*out)->pins = malloc(src->npins * sizeof *src->pins);
+        if (!(*out)->pins) {
+            tk_curve_free(out);
+            return tk_error_set(err, TK_ENOMEM, "out of memory");
+        }
+        memcpy((*out)->pins, src->pins, src->npins * sizeof *src->pins);
+        (*out)->npins = src->npins;
+    }
+    return TK_OK;
+}
+
+/* The pins of src on `out`, resampled from it: a pinned vertex goes to the
+ * vertex at its share of the component's vertices (an open component's
+ * ends to its ends), and onto its constraint. */
+static int carry_pins(const tk_curve *src, tk_curve *out, tk_error *err)
+{
+    if (!src->npins)
+        return TK_OK;
+    out->pins = malloc(src->npins * sizeof *src->pins);
+    if (!out->pins)
+        return tk_error_set(err, TK_ENOMEM, "out of memory");
+    for (size_t i = 0; i < src->npins; i++) {
+        tk_pin p = src->pins[i];
+        size_t n = tk_curve_comp_vertices(src, p.comp), m = tk_curve_comp_vertices(out, p.comp);
+        if (!src->closed[p.comp])
+            p.vertex = (size_t)llround((double)p.vertex * (double)(m - 1) / (double)(n - 1));
+        else
+            p.vertex = (size_t)llround((double)p.vertex * (double)m / (double)n) % m;
+        if (tk_curve_pin_of(out, out->offset[p.comp] + p.vertex))
+            return tk_error_set(err, TK_EINVAL,
+                                "resampled to %zu vertices, component %zu has two constraints "
+                                "on its vertex %zu",
+                                m, p.comp, p.vertex);
+        out->pins[out->npins++] = p;
+    }
+    tk_curve_pins_snap(out);
     return TK_OK;
 }
 
@@ -177,23 +215,39 @@ void tk_curve_edge_range(const tk_curve *c, double *shortest, double *longest)
         *longest = hi;
 }
 
+/* y = R x for a row-major R */
+static void rotate3(const double r[9], double *x)
+{
+    double y0 = r[0] * x[0] + r[1] * x[1] + r[2] * x[2];
+    double y1 = r[3] * x[0] + r[4] * x[1] + r[5] * x[2];
+    double y2 = r[6] * x[0] + r[7] * x[1] + r[8] * x[2];
+    x[0] = y0;
+    x[1] = y1;
+    x[2] = y2;
+}
+
+/* The pins move with the curve: their points, planes and lines are where
+ * the curve is. */
 void tk_curve_translate(tk_curve *c, const double shift[3])
 {
     for (size_t v = 0; v < c->nvert; v++)
         for (int k = 0; k < 3; k++)
             c->xyz[3 * v + k] += shift[k];
+    for (size_t i = 0; i < c->npins; i++) {
+        tk_pin *p = &c->pins[i];
+        for (int k = 0; k < 3; k++)
+            p->point[k] += shift[k];
+        p->offset += p->normal[0] * shift[0] + p->normal[1] * shift[1] + p->normal[2] * shift[2];
+    }
 }
 
 void tk_curve_rotate(tk_curve *c, const double r[9])
 {
-    for (size_t v = 0; v < c->nvert; v++) {
-        double *x = c->xyz + 3 * v;
-        double y0 = r[0] * x[0] + r[1] * x[1] + r[2] * x[2];
-        double y1 = r[3] * x[0] + r[4] * x[1] + r[5] * x[2];
-        double y2 = r[6] * x[0] + r[7] * x[1] + r[8] * x[2];
-        x[0] = y0;
-        x[1] = y1;
-        x[2] = y2;
+    for (size_t v = 0; v < c->nvert; v++)
+        rotate3(r, c->xyz + 3 * v);
+    for (size_t i = 0; i < c->npins; i++) {
+        rotate3(r, c->pins[i].point);
+        rotate3(r, c->pins[i].normal);
     }
 }
 
@@ -201,6 +255,12 @@ void tk_curve_scale(tk_curve *c, double factor)
 {
     for (size_t i = 0; i < 3 * c->nvert; i++)
         c->xyz[i] *= factor;
+    for (size_t i = 0; i < c->npins; i++) {
+        tk_pin *p = &c->pins[i];
+        for (int k = 0; k < 3; k++)
+            p->point[k] *= factor;
+        p->offset *= factor;
+    }
 }
 
 void tk_curve_centroid(const tk_curve *c, double centre[3])
@@ -480,9 +540,11 @@ int tk_curve_resample(const tk_curve *src, const size_t *counts, tk_curve **out,
         spline_free(&sp);
     }
     if (rc == TK_OK)
-        rc = tk_curve_validate(*out, err);
+        rc = carry_pins(src, *out, err);
     else
         tk_error_set(err, rc, "out of memory resampling");
+    if (rc == TK_OK)
+        rc = tk_curve_validate(*out, err);
     if (rc)
         tk_curve_free(out);
     return rc;
@@ -583,5 +645,6 @@ int tk_curve_equilateralize(tk_curve *c, tk_error *err)
         free(old);
         free(arc);
     }
+    tk_curve_pins_snap(c);
     return TK_OK;
 }

@@ -75,8 +75,16 @@
  * 60.99699 (seed 1 spends its tries before the reserve). */
 #define ESCAPE_RESERVE 0.2
 
-void tk_escape_start(tk_run *r, bool resumed)
+void tk_escape_start(tk_run *r, bool resumed, const tk_curve *start)
 {
+    /* An open component's hooks are not guarded by a type the invariants
+     * can tell (an open rope has none): a deformation, applied at once,
+     * could pull a clasp's ropes through each other and the run would go
+     * on from an unhooked curve.  Such a curve tries no escape. */
+    r->escape.most = r->opt.escapes;
+    for (size_t comp = 0; comp < start->ncomp; comp++)
+        if (!start->closed[comp])
+            r->escape.most = 0;
     r->escape.rng = r->opt.seed;
     r->escape.coarse = r->escape.best_coarse = NAN;
     r->escape.explore_over = resumed; /* its exploration's best is not kept */
@@ -184,7 +192,7 @@ static int note(tk_run *r, tk_error *err)
  * 60.996636 and rising to 60.996693 by the window's end. */
 void tk_escape_after_step(tk_run *r)
 {
-    if (r->opt.escapes > 0)
+    if (r->escape.most > 0)
         (void)note(r, NULL); /* out of memory for the copy: no best, the run's curve ends it */
 }
 
@@ -195,13 +203,13 @@ int tk_escape_tries(const tk_run *r)
 
 static bool tries_left(const tk_run *r)
 {
-    return tk_escape_tries(r) - r->escape.explore_tries < r->opt.escapes &&
+    return tk_escape_tries(r) - r->escape.explore_tries < r->escape.most &&
            tk_schedule_spent(r) < 1.0 - ESCAPE_RESERVE;
 }
 
 bool tk_escape_ask(tk_run *r)
 {
-    if (r->opt.escapes <= 0 || r->escape.due)
+    if (r->escape.most <= 0 || r->escape.due)
         return r->escape.due;
     if (note(r, NULL) != TK_OK)
         return false; /* out of memory for the copy: no escape */
@@ -247,6 +255,7 @@ static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far,
     bool found = false;
     for (int size = 0; !rc && !found && size < ESCAPE_SIZES; size++, a *= ESCAPE_SHRINK) {
         tk_generate_fourier(*out, best, coef, ESCAPE_MODES, a);
+        tk_curve_pins_snap(*out); /* a pinned vertex stays on its constraint */
         tk_measure m;
         tk_error why;
         if (tk_thickness_measure(*out, NULL, &m, &why) != TK_OK ||
@@ -306,6 +315,10 @@ static int try_curve(tk_run *r, const tk_curve *best, double thickness, double r
 {
     int kind = index % TRY_KINDS;
     *turned = false;
+    /* turned inside out, a pinned vertex would leave its constraint far
+     * behind: a far deformation instead */
+    if (kind == TRY_TURNED && best->npins)
+        kind = TRY_FAR;
     if (kind != TRY_TURNED)
         return deformed(r, best, thickness, kind == TRY_FAR, out, amplitude, err);
     double offset[3];
@@ -363,7 +376,7 @@ static int try_curve(tk_run *r, const tk_curve *best, double thickness, double r
 
 static bool explore_more(const tk_run *r)
 {
-    return r->escape.explore_tries < r->opt.escapes && r->escape.explore_fails < EXPLORE_FAILS &&
+    return r->escape.explore_tries < r->escape.most && r->escape.explore_fails < EXPLORE_FAILS &&
            tk_schedule_spent(r) < EXPLORE_SHARE;
 }
 
@@ -509,7 +522,7 @@ static void judge_coarse(tk_run *r)
 
 int tk_escape_before_step(tk_run *r, tk_error *err)
 {
-    if (r->opt.escapes > 0)
+    if (r->escape.most > 0)
         judge_coarse(r);
     if (!r->escape.explore_over && r->escape.explore_tries > 0 &&
         r->escape.explore_pending == TK_EXPLORE_NONE && !(tk_schedule_spent(r) < EXPLORE_SHARE)) {
@@ -573,7 +586,7 @@ int tk_escape_finish(tk_run *r, bool *restored, tk_error *err)
      * T(2,3) tightened at 2,400 vertices for 600 s, which never converged
      * and so tried none, stopped at 32.7431151 where it had been at
      * 32.7431102.  A resumed run's best is kept all the same. */
-    if (r->opt.escapes <= 0 && !r->escape.best)
+    if (r->escape.most <= 0 && !r->escape.best)
         return TK_OK;
     int rc = note(r, err);
     if (rc || !r->escape.best)

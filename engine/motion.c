@@ -8,6 +8,7 @@
 
 #include "run.h"
 #include "tk/geometry.h"
+#include "tk/rigidity.h"
 
 void tk_motion_free(tk_run *r)
 {
@@ -165,7 +166,7 @@ static void add_equalising_motion(tk_run *r, const tk_curve *c, double *u)
         shift = c->closed[comp] ? shift / (double)n : 0.0;
         for (size_t k = 0; k < n; k++) {
             size_t v = c->offset[comp] + k;
-            if (r->shared.fixed[v] || (!c->closed[comp] && (k == 0 || k + 1 == n)))
+            if (r->shared.pin[v] || (!c->closed[comp] && (k == 0 || k + 1 == n)))
                 continue;
             size_t before = c->closed[comp] ? (k + n - 1) % n : k - 1;
             const double *prev = tk_curve_vertex(c, c->offset[comp] + before);
@@ -191,8 +192,8 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
     double *grad = r->motion.grad, *motion = r->motion.motion, *work = r->motion.work;
     tk_curve_length_gradient(c, grad);
     for (size_t v = 0; v < c->nvert; v++)
-        if (r->shared.fixed[v])
-            grad[3 * v] = grad[3 * v + 1] = grad[3 * v + 2] = 0.0;
+        if (r->shared.pin[v])
+            tk_pin_project(r->shared.pin[v], grad + 3 * v);
     for (size_t i = 0; i < n3; i++)
         motion[i] = -grad[i];
     if (equalise)
@@ -286,4 +287,52 @@ bool tk_motion_descends(const tk_run *r)
     for (size_t i = 0; i < 3 * r->shared.curve->nvert; i++)
         slope += r->motion.grad[i] * r->motion.motion[i];
     return slope < 0.0;
+}
+
+/* The pins' forces: at a pinned vertex the unprojected motion -grad + A x
+ * (the struts' and kinks' gradients as they are, their forces x from the
+ * last solve) has a part the pin's constraint takes up, (I - P) of it;
+ * that part's length is the constraint's force, as a strut's force is the
+ * multiplier of its constraint.  On a tight curve the motion's projected
+ * part vanishes, and the pin's force balances the rest. */
+int tk_run_pin_forces(const tk_run *r, double *force, tk_error *err)
+{
+    const tk_curve *c = r->shared.curve;
+    const tk_constraints *set = &r->active.set;
+    size_t n3 = 3 * c->nvert, ncon = set->struts.count + set->nkinks;
+    double *w = malloc(n3 * sizeof *w), *x = malloc((ncon ? ncon : 1) * sizeof *x);
+    cholmod_common *cc = tk_nnls_common(r->shared.nnls);
+    cholmod_sparse *a = NULL;
+    int rc = w && x ? TK_OK : tk_error_set(err, TK_ENOMEM, "out of memory for the forces");
+    if (!rc && ncon)
+        rc = tk_rigidity_build_branches(c, set->struts.items, set->struts.count, set->kinks,
+                                        set->kink_edge, set->nkinks, cc, &a, err);
+    if (!rc) {
+        tk_curve_length_gradient(c, w);
+        for (size_t i = 0; i < n3; i++)
+            w[i] = -w[i];
+        for (size_t j = 0; j < set->struts.count; j++)
+            x[j] = set->struts.items[j].force;
+        for (size_t k = 0; k < set->nkinks; k++)
+            x[set->struts.count + k] = set->kinks[k].force;
+        if (a) {
+            const int *colp = a->p, *row = a->i;
+            const double *val = a->x;
+            for (size_t j = 0; j < ncon; j++)
+                for (int k = colp[j]; k < colp[j + 1]; k++)
+                    w[row[k]] += val[k] * x[j];
+        }
+        for (size_t i = 0; i < c->npins; i++) {
+            const tk_pin *p = &c->pins[i];
+            const double *wv = w + 3 * (c->offset[p->comp] + p->vertex);
+            double kept[3] = {wv[0], wv[1], wv[2]};
+            tk_pin_project(p, kept);
+            double d[3] = {wv[0] - kept[0], wv[1] - kept[1], wv[2] - kept[2]};
+            force[i] = tk_norm(d, 3);
+        }
+    }
+    cholmod_free_sparse(&a, cc);
+    free(w);
+    free(x);
+    return rc;
 }

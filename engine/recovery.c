@@ -268,8 +268,9 @@ static int metric_build(const tk_run *r, cholmod_common *cc, cholmod_sparse **ou
         if (!(edge > 0.0))
             continue;
         /* row (as t's column) v of the second difference, in units of
-         * l^2: (x_prev - 2 x_v + x_next) l^2 / e^2; a fixed vertex does
-         * not move, so its column is left out */
+         * l^2: (x_prev - 2 x_v + x_next) l^2 / e^2; a pinned vertex moves
+         * along its constraint alone, so its column is left out (its
+         * rows of the step are then the projected rigidity matrix's) */
         double w = l2 / (edge * edge);
         size_t first = c->offset[comp], count = tk_curve_comp_vertices(c, comp);
         for (size_t v = first; v < first + count; v++) {
@@ -281,7 +282,7 @@ static int metric_build(const tk_run *r, cholmod_common *cc, cholmod_sparse **ou
             at[2] = next;
             for (int x = 0; x < 3; x++, rows++)
                 for (int k = 0; k < 3; k++) {
-                    if (r->shared.fixed[at[k]])
+                    if (r->shared.pin[at[k]])
                         continue;
                     ti[t->nnz] = (int)(3 * at[k] + (size_t)x);
                     tj[t->nnz] = (int)rows;
@@ -395,7 +396,7 @@ static int inequality_step(tk_run *r, double *worst, bool *improved, tk_error *e
             double root = sqrt(INEQUALITY_DAMPING * d);
             bi[z] = (int)(m + j);
             bx[z++] = root;
-            /* a column that is all zero (fixed vertices) cannot move: its
+            /* a column that is all zero (pinned vertices) cannot move: its
              * term is left out */
             rhs[m + j] = root > 0.0 ? r->recovery.rhs[j] / root : 0.0;
         }

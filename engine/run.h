@@ -110,7 +110,11 @@ struct tk_run {
         tk_curve *trial;
         tk_strut_finder *finder;
         tk_nnls *nnls;
-        bool *fixed;     /* per vertex: end points of open components */
+        /* per vertex: its constraint, or NULL where it moves freely (an
+         * open component's end with none stays where it is) */
+        const tk_pin **pin;
+        tk_pin *pins;    /* what pin points into, npins of them */
+        size_t npins;
     } shared;
 
     struct {             /* active.c */
@@ -228,6 +232,7 @@ struct tk_run {
         size_t nlog, log_capacity;
         int improved;
         double type_seconds; /* the deformations' types checked */
+        int most;            /* escapes option, or 0 for a curve with an open component */
     } escape;
 
     struct {             /* tighten.c */
@@ -354,7 +359,8 @@ int tk_active_find(tk_run *r, const tk_curve *c, tk_constraints *set, tk_error *
 /* Adds to the active set the constraints a step to `trial` broke that were
  * not active (the finder fitted to `trial`); *added counts them. */
 int tk_active_expand(tk_run *r, const tk_curve *trial, size_t *added, tk_error *err);
-/* The rigidity matrix of a set at c, the rows of fixed vertices zeroed. */
+/* The rigidity matrix of a set at c, the rows of pinned vertices projected
+ * onto the directions their constraints allow (tk_pin_project). */
 int tk_active_matrix(tk_run *r, const tk_curve *c, const tk_constraints *set,
                      cholmod_sparse **a, tk_error *err);
 /* The forces x (struts, then kinks) onto the active set, kept for the next
@@ -495,8 +501,9 @@ size_t tk_schedule_window(const tk_run *r, size_t steps);
 /* ---- escape.c ---- */
 
 /* A new run's escapes: the random stream at the seed, nothing explored
- * or noted yet (a resumed run explores no more). */
-void tk_escape_start(tk_run *r, bool resumed);
+ * or noted yet (a resumed run explores no more), none at all for a start
+ * with an open component. */
+void tk_escape_start(tk_run *r, bool resumed, const tk_curve *start);
 /* Whether the final polygon has converged: its ropelength fell by less
  * than a set fraction over a window of steps, or by less than a larger
  * one for a set share of the budget (a crawl). */

@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "run.h"
 #include "tk/record.h"
@@ -174,12 +175,24 @@ static double resolution_final(const tk_run *r)
 
 /* The vertices of the current coarse level at ropelength rope: with the
  * vertices option, exactly that count at the last level. */
+/* The fewest vertices the run's curve can have: 3 a closed component, 2
+ * an open one.  An open rope pulled straight has a ropelength near 0 (its
+ * thickness grows without bound), and its resolution would ask for none. */
+static size_t least_count(const tk_run *r)
+{
+    size_t least = 0;
+    for (size_t comp = 0; comp < r->shared.curve->ncomp; comp++)
+        least += r->shared.curve->closed[comp] ? 3 : 2;
+    return least;
+}
+
 static size_t level_count(const tk_run *r, double rope)
 {
     int level = r->schedule.coarse_level;
-    if (r->opt.vertices > 0)
-        return (size_t)ceil(ldexp((double)r->opt.vertices, -level));
-    return (size_t)ceil(ldexp(r->opt.resolution, -level) * rope);
+    size_t n = r->opt.vertices > 0 ? (size_t)ceil(ldexp((double)r->opt.vertices, -level))
+                                   : (size_t)ceil(ldexp(r->opt.resolution, -level) * rope);
+    size_t least = least_count(r);
+    return n > least ? n : least;
 }
 
 size_t tk_schedule_final_count(const tk_run *r)
@@ -192,7 +205,8 @@ size_t tk_schedule_final_count(const tk_run *r)
     double rope = r->schedule.final_ropelength > 0.0 && !(r->opt.re_resolve > 0.0)
                       ? r->schedule.final_ropelength
                       : r->schedule.start_ropelength;
-    return (size_t)ceil(r->opt.resolution * rope);
+    size_t n = (size_t)ceil(r->opt.resolution * rope), least = least_count(r);
+    return n > least ? n : least;
 }
 
 /* Everything sized by the curve's vertices: the trial curve, the strut
@@ -214,15 +228,32 @@ int tk_schedule_fit(tk_run *r, tk_error *err)
         rc = tk_stepping_fit(r, c->nvert, err);
     if (rc)
         return rc;
-    free(r->shared.fixed);
-    r->shared.fixed = calloc(c->nvert, sizeof *r->shared.fixed);
-    if (!r->shared.fixed)
+    /* the curve's pins, and a point where an open component's end has none */
+    free(r->shared.pin);
+    free(r->shared.pins);
+    r->shared.npins = 0;
+    r->shared.pin = calloc(c->nvert, sizeof *r->shared.pin);
+    r->shared.pins = malloc((c->npins + 2 * c->ncomp) * sizeof *r->shared.pins);
+    if (!r->shared.pin || !r->shared.pins)
         return tk_error_set(err, TK_ENOMEM, "out of memory for a run of %zu vertices", c->nvert);
-    for (size_t comp = 0; comp < c->ncomp; comp++)
-        if (!c->closed[comp]) {
-            r->shared.fixed[c->offset[comp]] = true;
-            r->shared.fixed[c->offset[comp + 1] - 1] = true;
+    for (size_t i = 0; i < c->npins; i++)
+        r->shared.pins[r->shared.npins++] = c->pins[i];
+    for (size_t comp = 0; comp < c->ncomp; comp++) {
+        size_t n = tk_curve_comp_vertices(c, comp);
+        for (size_t end = 0; end < 2 && !c->closed[comp]; end++) {
+            size_t k = end ? n - 1 : 0;
+            if (tk_curve_pin_of(c, c->offset[comp] + k))
+                continue;
+            tk_pin *p = &r->shared.pins[r->shared.npins++];
+            *p = (tk_pin){.comp = comp, .vertex = k, .kind = TK_PIN_POINT};
+            memcpy(p->point, tk_curve_vertex(c, c->offset[comp] + k), sizeof p->point);
         }
+    }
+    for (size_t i = 0; i < r->shared.npins; i++) {
+        const tk_pin *p = &r->shared.pins[i];
+        if (p->kind != TK_PIN_FREE)
+            r->shared.pin[c->offset[p->comp] + p->vertex] = p;
+    }
     tk_active_reset(r);
     return TK_OK;
 }
@@ -274,6 +305,13 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
                             "tighten a coarser polygon (a resolution resamples it)",
                             start->nvert, TK_RUN_MAX_VERTICES);
     int rc = tk_curve_copy(start, curve, err);
+    /* a start's pinned vertices a rounding away from their constraints
+     * are put on them; farther, the start is refused */
+    double shortest = 0.0;
+    if (!rc && (*curve)->npins) {
+        tk_curve_edge_range(*curve, &shortest, NULL);
+        rc = tk_curve_pins_settle(*curve, TK_PIN_SETTLE * shortest, err);
+    }
     if (!rc)
         rc = measure(*curve, &m, err);
     if (rc)

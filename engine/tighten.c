@@ -34,7 +34,8 @@ void tk_run_free(tk_run **p)
     tk_curve_free(&r->shared.trial);
     tk_strut_finder_free(&r->shared.finder);
     tk_nnls_free(&r->shared.nnls);
-    free(r->shared.fixed);
+    free(r->shared.pin);
+    free(r->shared.pins);
     tk_active_free(r);
     tk_motion_free(r);
     tk_stepping_free(r);
@@ -147,7 +148,7 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
     r->life.cpu_spent = at ? at->seconds : 0.0;
     tk_run_clock_enter(r);
     r->life.flow_from = at ? at->flow_time : 0.0;
-    tk_escape_start(r, at != NULL);
+    tk_escape_start(r, at != NULL, start);
     rc = tk_nnls_new(&r->shared.nnls, err);
     if (!rc)
         rc = at ? tk_schedule_resume(r, start, at, err) : tk_schedule_start(r, start, err);

@@ -26,6 +26,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 /* Longest number token we hand to strtod: %.17g needs at most 24 chars, so
@@ -40,12 +41,69 @@
 
 /* ---------------------------------------------------------------- tokens */
 
+/* A constraint comment (tk/pin.h): "# Constraint k Kind numbers" defines
+ * constraint k, "# Cst: k" after a vertex's coordinates puts it on the
+ * vertex whose last coordinate is on that line. */
+typedef struct directive {
+    bool use;       /* "Cst:", else "Constraint" */
+    size_t line;
+    const char *text; /* after the keyword, up to the comment's end */
+    size_t n;
+    size_t vertex;  /* use: the global vertex, SIZE_MAX when none */
+} directive;
+
+/* At most this many constraint comments (a clasp has eight). */
+#define VECT_MAX_DIRECTIVES 10000
+
 typedef struct lexer {
     const unsigned char *s;
     size_t len;
     size_t pos;
     size_t line; /* 1-based line of s[pos] */
+    directive *dirs;
+    size_t ndirs, dir_capacity;
+    bool dir_overflow; /* too many, or out of memory for them */
+    size_t vertex, vertex_line; /* the last vertex read, and its line (0: none) */
 } lexer;
+
+static bool starts_with(const char *p, size_t n, const char *word)
+{
+    size_t w = strlen(word);
+    return n >= w && strncasecmp(p, word, w) == 0;
+}
+
+/* The comment s[from, to) on `line`, kept if it is a constraint's. */
+static void comment(lexer *lx, size_t from, size_t to, size_t line)
+{
+    const char *p = (const char *)lx->s + from;
+    size_t n = to - from;
+    while (n > 0 && (*p == ' ' || *p == '\t')) {
+        p++;
+        n--;
+    }
+    bool use = starts_with(p, n, "Cst:");
+    if (!use && !(starts_with(p, n, "Constraint") && n > 10 && (p[10] == ' ' || p[10] == '\t')))
+        return;
+    size_t skip = use ? 4 : 10;
+    if (lx->ndirs == lx->dir_capacity) {
+        size_t cap = lx->dir_capacity ? 2 * lx->dir_capacity : 16;
+        directive *grown = cap <= VECT_MAX_DIRECTIVES ? realloc(lx->dirs, cap * sizeof *grown)
+                                                      : NULL;
+        if (!grown) {
+            lx->dir_overflow = true;
+            return;
+        }
+        lx->dirs = grown;
+        lx->dir_capacity = cap;
+    }
+    lx->dirs[lx->ndirs++] = (directive){
+        .use = use,
+        .line = line,
+        .text = p + skip,
+        .n = n - skip,
+        .vertex = use && lx->vertex_line == line ? lx->vertex : SIZE_MAX,
+    };
+}
 
 /* n == 0 means end of file; line is then the last line that has text. */
 typedef struct token {
@@ -78,9 +136,11 @@ static void skip_space_and_comments(lexer *lx)
             /* A NUL ends a comment and starts a token, so that it is
              * refused as binary data on its line: no text file holds
              * one, and a store of C strings would cut the text there. */
+            size_t from = ++lx->pos;
             while (lx->pos < lx->len && lx->s[lx->pos] != '\n' && lx->s[lx->pos] != '\r' &&
                    lx->s[lx->pos] != '\0')
                 lx->pos++;
+            comment(lx, from, lx->pos, lx->line);
         } else {
             break;
         }
@@ -316,6 +376,182 @@ static const char CHANNEL[4] = {'r', 'g', 'b', 'a'};
 
 /* Parses the whole text into *out.  Counts are checked in text order so
  * that the first error reported is the first one a reader meets. */
+/* The VECT names of the kinds (tk_pin_kind order) and their numbers. */
+static const struct {
+    const char *name;
+    int count;
+} KINDS[] = {{"Free", 0}, {"Point", 3}, {"Plane", 4}, {"Line", 6}};
+
+/* Reads up to `most` numbers of a comment's text into v; how many. */
+static int comment_numbers(const char *p, size_t n, double *v, int most, bool *bad)
+{
+    char buf[VECT_MAX_NUMBER + 1];
+    int count = 0;
+    size_t i = 0;
+    *bad = false;
+    while (i < n) {
+        while (i < n && (p[i] == ' ' || p[i] == '\t'))
+            i++;
+        size_t start = i;
+        while (i < n && p[i] != ' ' && p[i] != '\t')
+            i++;
+        if (i == start)
+            break;
+        char *end;
+        if (count == most || i - start > VECT_MAX_NUMBER) {
+            *bad = true;
+            return count;
+        }
+        memcpy(buf, p + start, i - start);
+        buf[i - start] = '\0';
+        errno = 0;
+        v[count] = strtod(buf, &end);
+        if (*end != '\0' || errno == ERANGE || !isfinite(v[count])) {
+            *bad = true;
+            return count;
+        }
+        count++;
+    }
+    return count;
+}
+
+/* A constraint number: a whole number from 1, and where it ends. */
+static long constraint_number(const char *p, size_t n, size_t *used)
+{
+    size_t i = 0;
+    while (i < n && (p[i] == ' ' || p[i] == '\t'))
+        i++;
+    long k = 0;
+    size_t start = i;
+    while (i < n && p[i] >= '0' && p[i] <= '9' && k < 100000000)
+        k = 10 * k + (p[i++] - '0');
+    *used = i;
+    return i > start && (i == n || p[i] == ' ' || p[i] == '\t') ? k : -1;
+}
+
+typedef struct definition {
+    long k;
+    const directive *d;
+} definition;
+
+static int by_number(const void *a, const void *b)
+{
+    long x = ((const definition *)a)->k, y = ((const definition *)b)->k;
+    return (x > y) - (x < y);
+}
+
+/* Constraint k's definition made a pin of global vertex v. */
+static int pin_of(parser *ps, tk_curve *c, const definition *def, size_t v, size_t use_line,
+                  tk_pin *pin)
+{
+    size_t at;
+    constraint_number(def->d->text, def->d->n, &at);
+    const char *p = def->d->text + at;
+    size_t n = def->d->n - at;
+    while (n > 0 && (*p == ' ' || *p == '\t')) {
+        p++;
+        n--;
+    }
+    int kind = -1;
+    size_t len = 0;
+    for (size_t i = 0; i < sizeof KINDS / sizeof *KINDS && kind < 0; i++) {
+        len = strlen(KINDS[i].name);
+        if (starts_with(p, n, KINDS[i].name) && (n == len || p[len] == ' ' || p[len] == '\t'))
+            kind = (int)i;
+    }
+    if (kind < 0)
+        return fail(ps, TK_EPARSE, def->d->line,
+                    "constraint %ld: the kind is Plane a b c d, Point x y z, Line px py pz "
+                    "tx ty tz or Free", def->k);
+    double x[6];
+    bool bad;
+    int count = comment_numbers(p + len, n - len, x, 6, &bad);
+    if (bad || count != KINDS[kind].count)
+        return fail(ps, TK_EPARSE, def->d->line, "constraint %ld: %s takes %d numbers", def->k,
+                    KINDS[kind].name, KINDS[kind].count);
+    /* the component holding v: the last whose offset is at most v */
+    size_t lo = 0, hi = c->ncomp - 1;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo + 1) / 2;
+        if (c->offset[mid] <= v)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    *pin = (tk_pin){.comp = lo, .vertex = v - c->offset[lo], .kind = (tk_pin_kind)kind,
+                    .id = (int)def->k};
+    if (kind == TK_PIN_POINT) {
+        memcpy(pin->point, x, 3 * sizeof *x);
+    } else if (kind == TK_PIN_PLANE) {
+        memcpy(pin->normal, x, 3 * sizeof *x);
+        pin->offset = x[3];
+    } else if (kind == TK_PIN_LINE) {
+        memcpy(pin->point, x, 3 * sizeof *x);
+        memcpy(pin->normal, x + 3, 3 * sizeof *x);
+    }
+    tk_error why;
+    int rc = tk_curve_pin_add(c, pin, false, &why);
+    return rc ? fail(ps, rc == TK_ENOMEM ? TK_ENOMEM : TK_EPARSE, use_line, "%s", why.message)
+              : TK_OK;
+}
+
+/* The constraint comments (see `directive`) made pins of the curve. */
+static int apply_constraints(parser *ps, tk_curve *c)
+{
+    lexer *lx = &ps->lx;
+    if (lx->dir_overflow)
+        return fail(ps, TK_ELIMIT, lx->line, "more than %d constraint comments",
+                    VECT_MAX_DIRECTIVES);
+    if (lx->ndirs == 0)
+        return TK_OK;
+    definition *defs = malloc(lx->ndirs * sizeof *defs);
+    if (!defs)
+        return tk_error_set(ps->err, TK_ENOMEM, "out of memory for the constraints");
+    size_t ndefs = 0;
+    int rc = TK_OK;
+    for (size_t u = 0; u < lx->ndirs && !rc; u++) {
+        const directive *d = &lx->dirs[u];
+        size_t used;
+        long k = constraint_number(d->text, d->n, &used);
+        if (k < 1)
+            rc = fail(ps, TK_EPARSE, d->line,
+                      d->use ? "'# Cst: K' names its constraint by a number from 1"
+                             : "'# Constraint K KIND ...' numbers its constraint from 1");
+        else if (d->use && d->vertex == SIZE_MAX)
+            rc = fail(ps, TK_EPARSE, d->line,
+                      "'# Cst: %ld' must follow the coordinates of the vertex it constrains, "
+                      "on their line", k);
+        else if (!d->use)
+            defs[ndefs++] = (definition){k, d};
+    }
+    if (!rc)
+        qsort(defs, ndefs, sizeof *defs, by_number);
+    for (size_t i = 1; i < ndefs && !rc; i++)
+        if (defs[i].k == defs[i - 1].k) {
+            const directive *a = defs[i].d->line < defs[i - 1].d->line ? defs[i].d : defs[i - 1].d;
+            const directive *b = a == defs[i].d ? defs[i - 1].d : defs[i].d;
+            rc = fail(ps, TK_EPARSE, b->line, "constraint %ld is defined twice (first on line %zu)",
+                      defs[i].k, a->line);
+        }
+    for (size_t u = 0; u < lx->ndirs && !rc; u++) {
+        const directive *d = &lx->dirs[u];
+        if (!d->use)
+            continue;
+        size_t used;
+        definition key = {constraint_number(d->text, d->n, &used), NULL};
+        const definition *def = bsearch(&key, defs, ndefs, sizeof *defs, by_number);
+        tk_pin pin;
+        if (!def)
+            rc = fail(ps, TK_EPARSE, d->line,
+                      "constraint %ld is not defined ('# Constraint %ld KIND ...' in the "
+                      "header)", key.k, key.k);
+        else
+            rc = pin_of(ps, c, def, d->vertex, d->line, &pin);
+    }
+    free(defs);
+    return rc;
+}
+
 static int parse_vect(parser *ps, const tk_vect_limits *lim, tk_curve **out)
 {
     int rc = TK_OK;
@@ -489,6 +725,8 @@ static int parse_vect(parser *ps, const tk_vect_limits *lim, tk_curve **out)
                 if (a == 0)
                     vline = line;
             }
+            ps->lx.vertex = c->offset[i] + k;
+            ps->lx.vertex_line = line;
             /* Same test as tk_curve_validate, so that it never fails later. */
             if (k > 0 && !(distance3(x - 3, x) > 0.0)) {
                 rc = fail(ps, TK_EPARSE, vline,
@@ -560,6 +798,8 @@ static int parse_vect(parser *ps, const tk_vect_limits *lim, tk_curve **out)
         rc = fail(ps, TK_EPARSE, eof_line(&ps->lx), "%s", verr.message);
         goto done;
     }
+    if ((rc = apply_constraints(ps, c)))
+        goto done;
     *out = c;
     c = NULL;
 
@@ -612,6 +852,7 @@ int tk_vect_parse(const char *text, size_t len, const tk_vect_limits *limits,
     c_numeric_enter(&loc);
     int rc = parse_vect(&ps, limits ? limits : &defaults, out);
     c_numeric_leave(&loc);
+    free(ps.lx.dirs);
     return rc;
 }
 
@@ -760,9 +1001,37 @@ static int write_vect(const tk_curve *c, FILE *f, tk_error *err)
             goto io;
     if (fputc('\n', f) == EOF)
         goto io;
+    /* the pins as constraint comments, numbered in their order */
+    for (size_t i = 0; i < c->npins; i++) {
+        const tk_pin *p = &c->pins[i];
+        double v[6];
+        int count = KINDS[p->kind].count;
+        if (p->kind == TK_PIN_POINT) {
+            memcpy(v, p->point, 3 * sizeof *v);
+        } else if (p->kind == TK_PIN_PLANE) {
+            memcpy(v, p->normal, 3 * sizeof *v);
+            v[3] = p->offset;
+        } else if (p->kind == TK_PIN_LINE) {
+            memcpy(v, p->point, 3 * sizeof *v);
+            memcpy(v + 3, p->normal, 3 * sizeof *v);
+        }
+        if (fprintf(f, "# Constraint %zu %s", i + 1, KINDS[p->kind].name) < 0)
+            goto io;
+        for (int k = 0; k < count; k++)
+            if (fprintf(f, " %.17g", v[k]) < 0)
+                goto io;
+        if (fputc('\n', f) == EOF)
+            goto io;
+    }
     for (size_t v = 0; v < c->nvert; v++) {
         const double *x = c->xyz + 3 * v;
-        if (fprintf(f, "%.17g %.17g %.17g\n", x[0], x[1], x[2]) < 0)
+        if (fprintf(f, "%.17g %.17g %.17g", x[0], x[1], x[2]) < 0)
+            goto io;
+        for (size_t i = 0; i < c->npins; i++)
+            if (c->offset[c->pins[i].comp] + c->pins[i].vertex == v &&
+                fprintf(f, " # Cst: %zu", i + 1) < 0)
+                goto io;
+        if (fputc('\n', f) == EOF)
             goto io;
     }
     if (colour)

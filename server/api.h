@@ -52,6 +52,7 @@ typedef struct tk_submission {
     size_t len;
     tk_job_options options;
     json_t *json; /* the body when it was JSON */
+    json_t *constraints; /* its "constraints" (strings, as --constrain), or NULL */
 } tk_submission;
 
 /* Why a submission is refused (400, 415 or 422), and the member naming
@@ -64,5 +65,12 @@ typedef struct tk_problem {
 int tk_submission_decode(const char *content_type, const tk_query_pair *query, size_t nquery,
                          const char *body, size_t len, tk_submission *out, tk_problem *p);
 void tk_submission_clear(tk_submission *s);
+
+/* The submission's constraints on vertices added to its parsed curve c,
+ * and every constraint of c (its VECT's too) checked against the start
+ * as a run checks it (tk_curve_pins_settle): 422 naming the constraint
+ * otherwise.  *input is then the text to store: NULL when the VECT as
+ * sent holds every constraint, else c written out with them (free()). */
+int tk_submission_pins(const tk_submission *s, tk_curve *c, char **input, tk_problem *p);
 
 #endif

@@ -62,7 +62,13 @@ int tk_record_parts(const tk_run *run, const json_t *before, size_t keep,
     size_t ns = 0, nk = 0;
     const tk_strut *struts = tk_run_struts(run, &ns);
     const tk_kink *kinks = tk_run_kinks(run, &nk);
-    json_t *o = tk_json_contacts(c, struts, ns, kinks, nk, true);
+    double *pin_force = c->npins ? calloc(c->npins, sizeof *pin_force) : NULL;
+    if (pin_force && tk_run_pin_forces(run, pin_force, NULL) != TK_OK) {
+        free(pin_force); /* out of memory: the constraints without forces */
+        pin_force = NULL;
+    }
+    json_t *o = tk_json_contacts(c, struts, ns, kinks, nk, true, pin_force);
+    free(pin_force);
     json_object_set_new(o, "step", json_integer((json_int_t)tk_run_latest(run)->step));
     json_object_set_new(o, "thickness", tk_json_number(tk_run_latest(run)->thickness));
     parts[TK_PART_CONTACTS] = tk_json_dump(o, false);

@@ -148,6 +148,7 @@ static result post_job(tk_api *a, conn *c, const call *k)
     tk_vect_limits bounds = TK_VECT_LIMITS_INIT;
     bounds.max_vertices = a->cfg.max_vertices;
     tk_curve *curve = NULL;
+    char *text_pinned = NULL;
     tk_error err;
     result ret;
     /* what is known without the engine: the text, its limits, the
@@ -159,10 +160,14 @@ static result post_job(tk_api *a, conn *c, const call *k)
         ret = problem(a, c, 422, json_pack("{s:s}", "option", "vertices"), NULL, "option "
                       "'vertices': %zu vertices; the limit is %zu", sub.options.run.vertices,
                       a->cfg.max_vertices);
+    } else if (tk_submission_pins(&sub, curve, &text_pinned, &p)) {
+        ret = problem(a, c, p.status, p.member[0] ? json_pack("{s:s}", p.member, p.value) : NULL,
+                      NULL, "%s", p.detail);
     } else {
         /* the reader refuses a NUL anywhere: the text is a C string */
         json_t *doc = tk_job_new(sub.name, rq->who, &sub.options, curve->ncomp, curve->nvert);
-        char *input = strndup(sub.vect, sub.len);
+        char *input = text_pinned ? text_pinned : strndup(sub.vect, sub.len);
+        text_pinned = NULL;
         int rc = doc && input ? tk_pool_submit(a->pool, doc, input, &err)
                               : tk_error_set(&err, TK_ENOMEM, "out of memory");
         const char *retry[] = {MHD_HTTP_HEADER_RETRY_AFTER, "30", NULL};

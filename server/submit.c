@@ -7,6 +7,9 @@
 #include <string.h>
 #include <strings.h>
 
+#include "tk/pin.h"
+#include "tk/vect.h"
+
 __attribute__((format(printf, 5, 6))) static int refuse(tk_problem *p, unsigned status,
                                                         const char *member, const char *value,
                                                         const char *fmt, ...)
@@ -57,9 +60,19 @@ static int decode_json(const char *body, size_t len, tk_submission *out, tk_prob
     json_t *value;
     json_object_foreach(doc, key, value)
         if (strcmp(key, "vect") && strcmp(key, "catalogue") && strcmp(key, "name") &&
-            strcmp(key, "options"))
+            strcmp(key, "options") && strcmp(key, "constraints"))
             return refuse(p, 422, "field", key, "unknown field '%.60s' (expected vect or "
-                          "catalogue, name, options)", key);
+                          "catalogue, name, options, constraints)", key);
+    json_t *constraints = json_object_get(doc, "constraints"), *one;
+    size_t k;
+    if (constraints && (!json_is_array(constraints) || json_array_size(constraints) > TK_PIN_MOST))
+        return refuse(p, 422, "field", "constraints", "'constraints' must be an array of at "
+                      "most %d strings", TK_PIN_MOST);
+    json_array_foreach(constraints, k, one)
+        if (!json_is_string(one))
+            return refuse(p, 422, "field", "constraints", "'constraints' must be an array of "
+                          "strings (COMP:VERTEX=KIND, as tightknot tighten --constrain)");
+    out->constraints = constraints;
     json_t *vect = json_object_get(doc, "vect"), *cat = json_object_get(doc, "catalogue");
     json_t *name = json_object_get(doc, "name"), *options = json_object_get(doc, "options");
     if (!vect == !cat)
@@ -119,6 +132,39 @@ int tk_submission_decode(const char *content_type, const tk_query_pair *query, s
     if (rc)
         tk_submission_clear(out);
     return rc;
+}
+
+int tk_submission_pins(const tk_submission *s, tk_curve *c, char **input, tk_problem *p)
+{
+    *input = NULL;
+    json_t *one;
+    size_t k;
+    tk_error err;
+    json_array_foreach(s->constraints, k, one) {
+        tk_pin pin;
+        bool at_vertex;
+        const char *text = json_string_value(one);
+        if (tk_pin_parse(text, &pin, &at_vertex, &err) ||
+            tk_curve_pin_add(c, &pin, at_vertex, &err))
+            return refuse(p, err.code == TK_ENOMEM ? 503 : 422, "constraint", text, "%s",
+                          err.message);
+    }
+    if (c->npins) {
+        /* as tk_run_new will: a rounding off is closed, farther is
+         * refused (on a copy: the run settles the curve as sent) */
+        double shortest;
+        tk_curve *copy = NULL;
+        tk_curve_edge_range(c, &shortest, NULL);
+        if (tk_curve_copy(c, &copy, &err))
+            return refuse(p, 503, NULL, NULL, "%s", err.message);
+        int rc = tk_curve_pins_settle(copy, TK_PIN_SETTLE * shortest, &err);
+        tk_curve_free(&copy);
+        if (rc)
+            return refuse(p, 422, "field", "constraints", "%s", err.message);
+    }
+    if (json_array_size(s->constraints) && tk_vect_to_string(c, input, NULL, &err))
+        return refuse(p, 503, NULL, NULL, "%s", err.message);
+    return TK_OK;
 }
 
 void tk_submission_clear(tk_submission *s)

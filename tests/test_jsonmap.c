@@ -50,7 +50,7 @@ static void check_contacts(const char *file)
     tk_error err;
     ck_assert_int_eq(tk_thickness_contacts(c, 1e-3, &m, &struts, &kinks, &nk, &err), TK_OK);
     ck_assert_uint_gt(struts.count, 0);
-    json_t *doc = tk_json_contacts(c, struts.items, struts.count, kinks, nk, true);
+    json_t *doc = tk_json_contacts(c, struts.items, struts.count, kinks, nk, true, NULL);
     ck_assert_ptr_nonnull(doc);
     json_t *comps = json_object_get(doc, "components");
     ck_assert_uint_eq(json_array_size(comps), c->ncomp);
@@ -95,7 +95,7 @@ START_TEST(kinks_sit_at_their_vertices)
 {
     tk_curve *c = tkt_regular_polygon(12, 1.0);
     tk_kink kinks[2] = {{0, 0, 0.5, 1.5}, {0, 5, 0.5, 0.0}};
-    json_t *doc = tk_json_contacts(c, NULL, 0, kinks, 2, false);
+    json_t *doc = tk_json_contacts(c, NULL, 0, kinks, 2, false, NULL);
     json_t *list = json_object_get(doc, "kinks");
     double edge = 2.0 * sin(M_PI / 12.0);
     ck_assert(fabs(json_real_value(json_object_get(json_array_get(list, 0), "arclength"))) < 1e-15);

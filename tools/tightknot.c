@@ -270,8 +270,21 @@ static const char tighten_help_end[] =
     "out (add --converge to stop sooner when converged).  With --steps or\n"
     "--residual every option is as given.\n"
     "\n"
+    "Constraints on vertices (the file's own, '# Constraint K Plane a b c\n"
+    "d' in its header and '# Cst: K' after a vertex, come first):\n"
+    "  --constrain COMP:VERTEX=KIND   repeatable; the vertex (counted from 0\n"
+    "                          in its component) stays fixed (where it is),\n"
+    "                          at point:x,y,z, on plane:nx,ny,nz,d (n.x = d)\n"
+    "                          or on line:px,py,pz,tx,ty,tz, or is free (an\n"
+    "                          open component's ends are fixed unless\n"
+    "                          constrained otherwise); e.g. the ends of an\n"
+    "                          open rope sliding on two planes:\n"
+    "                          --constrain 0:0=plane:0,0,1,-10\n"
+    "                          --constrain 0:99=plane:0,0,1,10\n"
+    "\n"
     "Outputs:\n"
-    "  -o, --output OUT.vect   the tightened curve (VECT)\n"
+    "  -o, --output OUT.vect   the tightened curve (VECT, with its\n"
+    "                          constraints)\n"
     "  --struts OUT.json       the final struts and kinks with their forces\n"
     "                          ('-' for either: standard output, and the\n"
     "                          report then goes to standard error)\n"
@@ -336,6 +349,8 @@ typedef struct cli_args {
     tk_options run;       /* tighten's run options */
     tk_options_given given; /* those on the line */
     const char *output, *struts_out, *log_out, *snapshots;
+    const char *constrain[TK_PIN_MOST]; /* tighten: --constrain, in order */
+    size_t nconstrain;
     size_t every;
     int npos;             /* the arguments that are not options, in order */
     char **pos;
@@ -420,6 +435,8 @@ static int parse_args(const char *name, int argc, char **argv, unsigned cmd, cli
         tk_cli_text(&c, "log", 0, "OUT", &a->log_out, NULL);
         tk_cli_text(&c, "snapshots", 0, "DIR", &a->snapshots, NULL);
         tk_cli_flag(&c, "progress", 0, &a->progress, NULL);
+        tk_cli_texts(&c, "constrain", "C", a->constrain, TK_PIN_MOST, &a->nconstrain,
+                     NULL);
         tk_cli_fields(&c, &own_fields[OWN_EVERY], 1, a);
         tk_cli_fields(&c, tk_option_fields, tk_option_nfields, &a->run);
     }
@@ -728,10 +745,11 @@ static void print_struts_text(const char *name, const tk_measure *m, const tk_st
  * service's strut list (tk_json_contacts) with the file and thickness. */
 static json_t *struts_json(const char *name, const tk_curve *c, double thickness,
                            const tk_strut *struts, size_t nstruts, const tk_kink *kinks,
-                           size_t nkinks, bool with_force)
+                           size_t nkinks, bool with_force, const double *pin_force)
 {
     json_t *o = json_object();
-    json_t *contacts = tk_json_contacts(c, struts, nstruts, kinks, nkinks, with_force);
+    json_t *contacts =
+        tk_json_contacts(c, struts, nstruts, kinks, nkinks, with_force, pin_force);
     if (!o || !contacts) {
         json_decref(o);
         json_decref(contacts);
@@ -766,7 +784,7 @@ static int cmd_struts(int argc, char **argv)
         return status;
     if (a.json)
         status = print_json(struts_json(name, c, m.thickness, struts.items, struts.count, kinks,
-                                        nkinks, false));
+                                        nkinks, false, NULL));
     else
         print_struts_text(name, &m, &struts, kinks, nkinks, a.tolerance);
     tk_strut_list_free(&struts);
@@ -1115,8 +1133,18 @@ static int write_struts_file(const char *path, const char *name, tk_run *run)
     size_t ns = 0, nk = 0;
     const tk_strut *st = tk_run_struts(run, &ns);
     const tk_kink *kinks = tk_run_kinks(run, &nk);
-    json_t *o = struts_json(name, tk_run_curve(run), tk_run_latest(run)->thickness, st, ns,
-                            kinks, nk, true);
+    const tk_curve *c = tk_run_curve(run);
+    double *pin_force = c->npins ? calloc(c->npins, sizeof *pin_force) : NULL;
+    tk_error err;
+    if (c->npins && (!pin_force || tk_run_pin_forces(run, pin_force, &err) != TK_OK)) {
+        fprintf(stderr, "tightknot: the constraints' forces: %s\n",
+                pin_force ? err.message : "out of memory");
+        free(pin_force);
+        return EXIT_INPUT;
+    }
+    json_t *o = struts_json(name, c, tk_run_latest(run)->thickness, st, ns, kinks, nk, true,
+                            pin_force);
+    free(pin_force);
     char *text = tk_json_dump(o, true);
     json_decref(o);
     FILE *f = text ? open_output(path) : NULL;
@@ -1177,6 +1205,15 @@ static int cmd_tighten(int argc, char **argv)
     if (tk_vect_read_file(input, NULL, &c, &err) != TK_OK) {
         report(NULL, &err);
         return EXIT_INPUT;
+    }
+    for (size_t i = 0; i < a.nconstrain; i++) {
+        tk_pin pin;
+        bool at_vertex;
+        if (tk_pin_parse(a.constrain[i], &pin, &at_vertex, &err) ||
+            tk_curve_pin_add(c, &pin, at_vertex, &err)) {
+            tk_curve_free(&c);
+            return usage_error("tighten", "--constrain: %s", err.message);
+        }
     }
     if (a.snapshots && mkdir(a.snapshots, 0777) != 0 && errno != EEXIST) {
         fprintf(stderr, "tightknot: cannot make %s: %s\n", a.snapshots, strerror(errno));

@@ -20,6 +20,7 @@
 #include <stddef.h>
 
 #include "tk/error.h"
+#include "tk/pin.h"
 
 typedef struct tk_curve {
     size_t ncomp;     /* number of components (>= 1 for a real curve) */
@@ -29,6 +30,8 @@ typedef struct tk_curve {
     double *xyz;      /* 3 * nvert coordinates */
     bool has_colour;  /* true when colour holds one RGBA per component */
     double *colour;   /* 4 * ncomp, or NULL */
+    tk_pin *pins;     /* npins constraints on vertices, at most one a vertex */
+    size_t npins;
 } tk_curve;
 
 /* One edge of a curve, resolved to its vertices. */
@@ -83,8 +86,9 @@ double tk_curve_length(const tk_curve *c);
 /* Shortest and longest edge of the whole curve. */
 void tk_curve_edge_range(const tk_curve *c, double *shortest, double *longest);
 
-/* Rigid motions and scaling, applied in place. rotation is a row-major 3x3
- * matrix (assumed orthogonal; not checked). */
+/* Rigid motions and scaling, applied in place, to the pins too (their
+ * points, planes and lines move with the curve). rotation is a row-major
+ * 3x3 matrix (assumed orthogonal; not checked). */
 void tk_curve_translate(tk_curve *c, const double shift[3]);
 void tk_curve_rotate(tk_curve *c, const double rotation[9]);
 void tk_curve_scale(tk_curve *c, double factor);

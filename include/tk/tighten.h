@@ -249,6 +249,11 @@ const tk_step_report *tk_run_history(const tk_run *r, size_t *count);
 /* Active struts and kinks of the last step, with their NNLS forces. */
 const tk_strut *tk_run_struts(const tk_run *r, size_t *count);
 const tk_kink *tk_run_kinks(const tk_run *r, size_t *count);
+/* The force of each constraint on a vertex of the run's curve
+ * (tk_run_curve(r)->pins, in their order) at the last step, into
+ * force[0 .. npins): the part of the motion at the vertex its constraint
+ * takes up, as a strut's force is its constraint's multiplier. */
+int tk_run_pin_forces(const tk_run *r, double *force, tk_error *err);
 tk_stop_reason tk_run_stop_reason(const tk_run *r);
 
 /* One escape: where it started, the best ropelength then, where its

@@ -252,3 +252,55 @@ test('a job says which daemon runs it: none while queued, the one that ran it af
     assert.equal(job.state, 'done');
     assert.equal(job.daemon, m[1]);
 });
+
+describe('the catalogue clasp: its four planes, one constraint more, 400 steps', () => {
+    let cli;
+    const extra = '0:3=fixed';
+    before(async () => {
+        cli = await tighten(dir, join(CATALOGUE, 'simple_clasp.vect'), 'clasp', [
+            '--autoscale', '--steps', '400', '--constrain', extra,
+        ]);
+    });
+
+    test('{"catalogue", "constraints": [...]} equals the CLI, constraints and their forces too', async () => {
+        const queued = await submit(d, {
+            catalogue: 'simple_clasp', constraints: [extra], options: { autoscale: true, steps: 400 },
+        });
+        const job = await waitFinal(d, queued.id);
+        assertSameFigures(job, cli.summary);
+        await assertSameStruts(job, cli);
+        await assertSameCurve(job, cli);
+        const s = (await d.get(`/v1/jobs/${job.id}/struts`)).json;
+        assert.equal(s.constraints.length, 5, 'the file\'s four and the one given');
+        assert.deepEqual(s.constraints, cli.struts.constraints);
+        assert.ok(s.constraints.some((p) => p.constraint.startsWith('0:3=point:')), 'fixed: a point');
+        // the planes' ends: the rope's unit tension
+        for (const p of s.constraints.filter((q) => q.constraint.includes('=plane:')))
+            assert.ok(Math.abs(p.force - 1) < 0.05, `${p.constraint}: force ${p.force}`);
+        // the curve keeps them, as the file wrote them
+        const text = (await d.get(`/v1/jobs/${job.id}/vect`)).text;
+        assert.equal((text.match(/^# Constraint \d+ /gm) ?? []).length, 5);
+        assert.equal((text.match(/# Cst: \d+$/gm) ?? []).length, 5);
+    });
+
+    test('a constraint that cannot hold is a 422 naming it, and no job', async () => {
+        const before = (await d.get('/v1/jobs?limit=500')).json.jobs.length;
+        const cases = [
+            [['2:0=free'], 'constraint', /no component 2/],
+            [['0:99=free'], 'constraint', /component 0 has no vertex 99/],
+            [['0:5=plane:0,0,0,1'], 'constraint', /plane normal is zero/],
+            [['0:0=free'], 'constraint', /has a constraint already/],
+            [['0:5=plane:0,0,1,100'], 'field', /constraint 0:5=plane.*from it/],
+            [['0:5=wall'], 'constraint', /the kind is/],
+            [[5], 'field', /array of strings/],
+        ];
+        for (const [constraints, member, detail] of cases) {
+            const r = await d.post('/v1/jobs', { catalogue: 'simple_clasp', constraints, options: { steps: 5 } });
+            assert.equal(r.status, 422, JSON.stringify(constraints));
+            assert.match(r.headers.get('content-type'), /^application\/problem\+json/);
+            assert.ok(member in r.json, `${JSON.stringify(constraints)}: ${JSON.stringify(r.json)}`);
+            assert.match(r.json.detail, detail);
+        }
+        assert.equal((await d.get('/v1/jobs?limit=500')).json.jobs.length, before);
+    });
+});
