@@ -2,7 +2,7 @@
 
 import { api, ApiError, auth, fetchFile, TERMINAL } from './api.js';
 import { parseVect, splitFlat, torusLink, scaleToFit, writeVect } from './geometry.js';
-import { drawHistory, drawContactMap, fmtForce } from './charts.js';
+import { drawHistory, drawContactMap, fmtForce, openPair } from './charts.js';
 import { createView, forceColour, rampCss } from './view3d.js';
 import { equalTimeFrames, frameFlowTimes, recordCanvas, webmType } from './film.js';
 
@@ -550,6 +550,7 @@ function showFinal() {
     state.replayIndex = -1;
     view.setCurve(state.curve.comps, state.job.options.radius);
     view.setStruts(state.contacts?.struts || []);
+    view.setConstraints(state.contacts?.constraints || [], state.curve.comps);
     view.setShowStruts($('show-struts').checked);
     // Fit once per job, and with "follow" each time the curve moves on.
     if (state.fitted === false || ($('follow').checked && state.fitted !== state.curve.step)) {
@@ -557,7 +558,9 @@ function showFinal() {
         state.fitted = state.curve.step;
     }
     const n = state.contacts?.struts.length ?? 0;
-    $('view3d-label').textContent = `stored curve, step ${state.curve.step} · ${n} strut${n === 1 ? '' : 's'}`;
+    const pins = state.contacts?.constraints?.length ?? 0;
+    $('view3d-label').textContent = `stored curve, step ${state.curve.step} · ${n} strut${n === 1 ? '' : 's'}` +
+        (pins ? ` · ${pins} constrained vert${pins === 1 ? 'ex' : 'ices'} (dark balls; planes in violet)` : '');
     $('replay-final').disabled = true;
     drawChart();
     if (state.frames.length) {
@@ -631,6 +634,9 @@ function renderStruts() {
         colour: (s) => strutColour(s, fmax),
         onHover: (i) => setHot(i),
     });
+    $('map-caption').textContent = openPair(contacts)
+        ? '(each axis the arclength along one rope, as the paper\'s Figure 6)'
+        : '(arclength of the two ends; kinks on the diagonal)';
     $('strut-legend').innerHTML = struts.length
         ? `force 0 <span class="ramp" style="background:${rampCss}"></span> ${fmtForce(fmax)}` : '';
     state.hot = -1;

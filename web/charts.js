@@ -77,8 +77,71 @@ export function drawHistory(svg, steps, mark = null) {
 
 // One mark per strut at (a, b) = the arclengths of its ends with a <= b, its
 // mirror image faintly below the diagonal, kinks on the diagonal, and the
-// components' boundaries as dashed lines.
-export function drawContactMap(svg, contacts, { colour, onHover } = {}) {
+// components' boundaries as dashed lines.  Two open components (a clasp,
+// the paper's Figure 6) have a map of their own: each axis the arclength
+// along one of them.
+export function drawContactMap(svg, contacts, opts = {}) {
+    return openPair(contacts) ? drawOpenPairMap(svg, contacts, opts) : drawWholeMap(svg, contacts, opts);
+}
+
+// Two open components whose struts all join one to the other.
+export function openPair(contacts) {
+    const comps = contacts?.components || [];
+    return comps.length === 2 && comps.every((c) => !c.closed) &&
+        (contacts.struts || []).every((s) => s.edges[0][0] !== s.edges[1][0]);
+}
+
+// Zoomed on the contacts, as the paper's enlarged plot: both axes at one
+// scale, from a little before the first contact along each rope.
+function drawOpenPairMap(svg, contacts, { colour, onHover } = {}) {
+    svg.replaceChildren();
+    const S = 360, M = 30, E = 8;
+    const [c0, c1] = contacts.components;
+    const struts = contacts.struts || [];
+    // each end's arclength along its own component
+    const ends = struts.map((s) => {
+        const first = s.edges[0][0] === 0 ? 0 : 1;
+        return [s.arclength[first] - c0.start, s.arclength[1 - first] - c1.start];
+    });
+    let [a0, a1, b0, b1] = [0, c0.length, 0, c1.length];
+    if (ends.length) {
+        a0 = Math.min(...ends.map((e) => e[0])); a1 = Math.max(...ends.map((e) => e[0]));
+        b0 = Math.min(...ends.map((e) => e[1])); b1 = Math.max(...ends.map((e) => e[1]));
+        const pad = 0.15 * Math.max(a1 - a0, b1 - b0, 1e-9);
+        [a0, a1, b0, b1] = [Math.max(0, a0 - pad), Math.min(c0.length, a1 + pad),
+            Math.max(0, b0 - pad), Math.min(c1.length, b1 + pad)];
+    }
+    const span = S - M - E, most = Math.max(a1 - a0, b1 - b0);
+    const sx = (v) => M + ((v - a0) / most) * span;
+    const Y = (v) => E + span - ((v - b0) / most) * span;
+    const w = ((a1 - a0) / most) * span, h = ((b1 - b0) / most) * span;
+    svg.append(el('rect', { x: M, y: E + span - h, width: w, height: h, fill: '#fff', stroke: '#b8c0cc' }));
+    for (const v of ticks(a0, a1, 4))
+        svg.append(el('text', { x: sx(v), y: S - M + 13, 'text-anchor': 'middle' }, short(v)));
+    for (const v of ticks(b0, b1, 4))
+        svg.append(el('text', { x: M - 4, y: Y(v) + 3, 'text-anchor': 'end' }, short(v)));
+    svg.append(el('text', { x: M + span, y: S - 4, 'text-anchor': 'end' }, 'arclength along component 0'));
+    svg.append(el('text', { x: 10, y: E + span / 2, 'text-anchor': 'middle', transform: `rotate(-90 10 ${E + span / 2})`,
+        class: 'axis-title' }, 'along component 1'));
+    if (!struts.length)
+        svg.append(el('text', { x: M + span / 2, y: E + span / 2, 'text-anchor': 'middle', class: 'nodata' }, 'no contacts yet'));
+    const r = struts.length > 400 ? 2 : 3;
+    const out = [];
+    struts.forEach((s, i) => {
+        const [a, b] = ends[i];
+        const mark = el('circle', { cx: sx(a), cy: Y(b), r, fill: colour ? colour(s, i) : '#2563eb', class: 'strut-mark', 'data-index': i });
+        mark.append(el('title', {}, `strut ${i}: ${a.toFixed(3)} along component 0, ${b.toFixed(3)} along component 1, force ${fmtForce(s.force)}`));
+        if (onHover) {
+            mark.addEventListener('mouseenter', () => onHover(i));
+            mark.addEventListener('mouseleave', () => onHover(-1));
+        }
+        svg.append(mark);
+        out.push(mark);
+    });
+    return out;
+}
+
+function drawWholeMap(svg, contacts, { colour, onHover } = {}) {
     svg.replaceChildren();
     const S = 360, M = 30, E = 8;
     const comps = contacts?.components || [];

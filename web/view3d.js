@@ -54,6 +54,7 @@ export class NoView3D {
     clear() {}
     setCurve() {}
     setStruts() {}
+    setConstraints() {}
     highlight() {}
     clearHighlight() {}
     fit() {}
@@ -83,7 +84,8 @@ export class View3D {
         this.tubeGroup = new THREE.Group();
         this.strutGroup = new THREE.Group();
         this.highlightGroup = new THREE.Group();
-        this.scene.add(this.strutGroup, this.tubeGroup, this.highlightGroup);
+        this.constraintGroup = new THREE.Group();
+        this.scene.add(this.strutGroup, this.tubeGroup, this.highlightGroup, this.constraintGroup);
 
         this.tubes = [];      // per component: { mesh, line, n, closed }
         this.radius = 0.5;
@@ -221,6 +223,47 @@ export class View3D {
         if (mesh.instanceColor) mesh.instanceColor.needsUpdate = true;
         this.strutGroup.add(mesh);
         this.strutGroup.visible = this.showStruts;
+        this.render();
+    }
+
+    // constraints: the API's constraints ({comp, vertex, constraint: the
+    // --constrain text}); comps as setCurve's.  A constrained vertex is a
+    // dark ball; its plane a translucent square four diameters across
+    // about it, its line a rod through it, its point a cube.
+    setConstraints(constraints, comps) {
+        for (const m of this.constraintGroup.children) { m.geometry.dispose(); m.material.dispose(); }
+        this.constraintGroup.clear();
+        const d = 2 * this.radius;
+        for (const c of constraints || []) {
+            const pts = comps[c.comp]?.points;
+            const m = /=(\w+)(?::(.*))?$/.exec(c.constraint);
+            if (!pts || !m || 3 * c.vertex + 2 >= pts.length) continue;
+            const at = new THREE.Vector3(pts[3 * c.vertex], pts[3 * c.vertex + 1], pts[3 * c.vertex + 2]);
+            const x = (m[2] || '').split(',').map(Number);
+            const ball = new THREE.Mesh(new THREE.SphereGeometry(0.35 * d, 16, 12),
+                new THREE.MeshStandardMaterial({ color: 0x222831, roughness: 0.5 }));
+            ball.position.copy(at);
+            this.constraintGroup.add(ball);
+            const faint = new THREE.MeshStandardMaterial({ color: 0x7a4cc2, transparent: true, opacity: 0.3,
+                side: THREE.DoubleSide, depthWrite: false });
+            if (m[1] === 'plane' && x.length === 4) {
+                const sheet = new THREE.Mesh(new THREE.PlaneGeometry(4 * d, 4 * d), faint);
+                sheet.position.copy(at);
+                sheet.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1),
+                    new THREE.Vector3(x[0], x[1], x[2]).normalize());
+                this.constraintGroup.add(sheet);
+            } else if (m[1] === 'line' && x.length === 6) {
+                const rod = new THREE.Mesh(new THREE.CylinderGeometry(0.06 * d, 0.06 * d, 6 * d, 8), faint);
+                rod.position.copy(at);
+                rod.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0),
+                    new THREE.Vector3(x[3], x[4], x[5]).normalize());
+                this.constraintGroup.add(rod);
+            } else if (m[1] === 'point') {
+                const cube = new THREE.Mesh(new THREE.BoxGeometry(d, d, d), faint);
+                cube.position.copy(at);
+                this.constraintGroup.add(cube);
+            }
+        }
         this.render();
     }
 

@@ -470,6 +470,40 @@ test('the chart breaks its line where the run took another curve', async () => {
     assert.deepEqual(drawn.ticks.map((t) => t.split(':')[0]), ['step 3', 'step 6']);
 });
 
+test('a clasp shows its constrained ends and planes, and its contact map along each rope', async () => {
+    const { status, body: queued } = await api('/v1/jobs', {
+        method: 'POST', headers: { 'content-type': 'application/json' },
+        body: JSON.stringify({ catalogue: 'simple_clasp', options: { autoscale: true, steps: 600 } }),
+    });
+    assert.equal(status, 202, JSON.stringify(queued));
+    await waitJob(queued.id, ['done']);
+    await page.goto(`${base}/#job=${queued.id}`);
+    await page.waitForSelector('#job[data-phase="final"]');
+    const { body: contacts } = await api(`/v1/jobs/${queued.id}/struts`);
+    assert.equal(contacts.constraints.length, 4);
+    assert.match(await page.locator('#view3d-label').innerText(), /4 constrained vertices/);
+    assert.match(await page.locator('#map-caption').innerText(), /along one rope.*Figure 6/);
+    // one mark per strut, at its arclength along component 0 (x) and 1 (y):
+    // the same affine map for every mark, increasing along both
+    const marks = await page.locator('#contact-map .strut-mark').evaluateAll((ms) =>
+        ms.map((m) => [Number(m.getAttribute('data-index')), Number(m.getAttribute('cx')), Number(m.getAttribute('cy'))]));
+    assert.equal(marks.length, contacts.struts.length);
+    assert.ok(marks.length >= 2, 'a hooked clasp has struts');
+    const [c0, c1] = contacts.components;
+    const along = contacts.struts.map((s) => {
+        const first = s.edges[0][0] === 0 ? 0 : 1;
+        return [s.arclength[first] - c0.start, s.arclength[1 - first] - c1.start];
+    });
+    const [i, j] = [0, 1].map((k) => marks[k][0]);
+    const kx = (marks[1][1] - marks[0][1]) / (along[j][0] - along[i][0]);
+    for (const [n, cx, cy] of marks) {
+        assert.ok(Math.abs(cx - (marks[0][1] + kx * (along[n][0] - along[i][0]))) < 0.5, `strut ${n}: x`);
+        assert.ok(Math.abs(cy - (marks[0][2] - kx * (along[n][1] - along[i][1]))) < 0.5, `strut ${n}: y at the same scale`);
+    }
+    assert.ok(kx > 0);
+    await page.screenshot({ path: join(ARTIFACTS, 'clasp.png') });
+});
+
 test('no script errors', () => {
     assert.deepEqual(pageErrors, []);
     assert.deepEqual(consoleErrors.filter((e) => !/status of 4\d\d/.test(e)), []);
