@@ -17,6 +17,14 @@
 #include "tk/tighten.h"
 #include "tk/vect.h"
 
+/* Two pins alike, field by field (their padding is not theirs). */
+static bool same_pin(const tk_pin *a, const tk_pin *b)
+{
+    return a->comp == b->comp && a->vertex == b->vertex && a->kind == b->kind &&
+           !memcmp(a->normal, b->normal, sizeof a->normal) && a->offset == b->offset &&
+           !memcmp(a->point, b->point, sizeof a->point);
+}
+
 static tk_pin parsed(const char *text, bool *at_vertex)
 {
     tk_pin p;
@@ -39,7 +47,7 @@ START_TEST(text_round_trips_and_errors_name_the_constraint)
         tk_pin_format(&p, text, sizeof text);
         bool again;
         tk_pin q = parsed(text, &again);
-        ck_assert_msg(!memcmp(&p, &q, sizeof p), "%s -> %s", good[i], text);
+        ck_assert_msg(same_pin(&p, &q), "%s -> %s", good[i], text);
     }
     const char *bad[][2] = {{"0=plane:0,0,1,1", "COMP:VERTEX="},
                             {"a:0=free", "COMP:VERTEX="},
@@ -207,11 +215,8 @@ START_TEST(vect_keeps_the_constraints)
     ck_assert_msg(tk_vect_parse(text, strlen(text), NULL, &back, &err) == TK_OK, "%s",
                   err.message);
     ck_assert_uint_eq(back->npins, 3);
-    for (size_t i = 0; i < 3; i++) {
-        tk_pin a = c->pins[i], b = back->pins[i];
-        a.id = b.id = 0;
-        ck_assert_msg(!memcmp(&a, &b, sizeof a), "pin %zu", i);
-    }
+    for (size_t i = 0; i < 3; i++)
+        ck_assert_msg(same_pin(&c->pins[i], &back->pins[i]), "pin %zu", i);
     free(text);
     tk_curve_free(&back);
     /* errors name the line */

@@ -53,11 +53,12 @@ static tk_store *the_store(void)
     return fuzz_store;
 }
 
-static void store_and_read_back(const tk_submission *sub, const tk_curve *curve)
+static void store_and_read_back(const tk_submission *sub, const tk_curve *curve,
+                                const char *vect, size_t vlen)
 {
     tk_store *store = the_store();
     json_t *doc = tk_job_new(sub->name, NULL, &sub->options, curve->ncomp, curve->nvert);
-    char *input = strndup(sub->vect, sub->len);
+    char *input = strndup(vect, vlen);
     CHECK(doc && input);
     tk_error err;
     CHECK(tk_store_add(store, doc, input, &(tk_store_limits){1000000, 0, 0}, &err) == TK_OK);
@@ -74,7 +75,7 @@ static void store_and_read_back(const tk_submission *sub, const tk_curve *curve)
     char *text = NULL;
     size_t len = 0;
     CHECK(tk_store_part(store, id, TK_PART_INPUT, &text, &len, &err) == TK_OK);
-    CHECK(text && len == sub->len && memcmp(text, sub->vect, len) == 0);
+    CHECK(text && len == vlen && memcmp(text, vect, len) == 0);
     free(text);
     CHECK(tk_store_cancel(store, id, &err) == TK_OK);
     CHECK(tk_store_delete(store, id, &err) == TK_OK);
@@ -139,7 +140,26 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (rc == TK_OK) {
         /* what the store keeps is a C string: the reader let no NUL in */
         CHECK(memchr(sub.vect, '\0', sub.len) == NULL);
-        store_and_read_back(&sub, curve);
+        /* the constraints given: refused with a 4xx naming one, or the
+         * input to store is the curve written with every constraint, which
+         * reads back as the curve with them */
+        char *pinned = NULL;
+        size_t had = curve->npins;
+        if (tk_submission_pins(&sub, curve, &pinned, &problem) != TK_OK) {
+            CHECK(problem.status >= 400 && problem.status < 600 && problem.detail[0] != '\0');
+        } else if (pinned) {
+            CHECK(curve->npins == had + json_array_size(sub.constraints));
+            tk_curve *back = NULL;
+            CHECK(tk_vect_parse(pinned, strlen(pinned), NULL, &back, &err) == TK_OK);
+            CHECK(back->npins == curve->npins && back->nvert == curve->nvert);
+            CHECK(!memcmp(back->xyz, curve->xyz, 3 * curve->nvert * sizeof *curve->xyz));
+            tk_curve_free(&back);
+            store_and_read_back(&sub, curve, pinned, strlen(pinned));
+        } else {
+            CHECK(json_array_size(sub.constraints) == 0);
+            store_and_read_back(&sub, curve, sub.vect, sub.len);
+        }
+        free(pinned);
     } else {
         CHECK(rc == TK_EPARSE || rc == TK_ELIMIT);
         CHECK(strncmp(err.message, "line ", 5) == 0);

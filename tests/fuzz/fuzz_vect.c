@@ -6,7 +6,7 @@
  * truth: Definition 1's thickness is min(2 minrad, shortest), the tree's
  * shortest contact equals the brute-force one on small curves, every
  * strut reported lies within the bound, and writing the curve out and
- * reading it back gives the same coordinates bit for bit.  Any failed
+ * reading it back gives the same coordinates and constraints bit for bit.  Any failed
  * check aborts (a crash to the fuzzer). */
 #include <math.h>
 #include <stdint.h>
@@ -34,6 +34,14 @@ static void check_round_trip(const tk_curve *c)
     CHECK(tk_vect_parse(text, len, NULL, &back, &err) == TK_OK);
     CHECK(back->ncomp == c->ncomp && back->nvert == c->nvert);
     CHECK(memcmp(back->xyz, c->xyz, 3 * c->nvert * sizeof *c->xyz) == 0);
+    /* the constraints too, each the same (the writer numbers them anew) */
+    CHECK(back->npins == c->npins);
+    for (size_t i = 0; i < c->npins; i++) {
+        const tk_pin *a = &c->pins[i], *b = &back->pins[i];
+        CHECK(a->comp == b->comp && a->vertex == b->vertex && a->kind == b->kind &&
+              !memcmp(a->normal, b->normal, sizeof a->normal) && a->offset == b->offset &&
+              !memcmp(a->point, b->point, sizeof a->point));
+    }
     tk_curve_free(&back);
     free(text);
 }
