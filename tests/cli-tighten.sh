@@ -318,5 +318,36 @@ check $? "frames with a log lacking flow_time: exit 2, the line named: $(cat "$t
 [ $? -eq 1 ]
 check $? "frames without DIR: usage error: $(cat "$tmp/err")"
 
+# Constraints on vertices: a rope between the planes x = -5 and x = 5 given
+# on the command line tightens to their distance (exact: 10), its output
+# keeps them for the next run, the struts file gives each end the rope's
+# unit tension; a constraint that cannot hold is refused, naming it.
+awk 'BEGIN { n = 40; print "VECT"; print "1 " n " 0"; print n; print 0
+    for (k = 0; k < n; k++) { s = k / (n - 1)
+        printf "%.17g %.17g %.17g\n", -5 + 10 * s, 3 * s + 1.5 * sin(6.283185307179586 * s), 0.8 * sin(3.141592653589793 * s) } }' \
+    >"$tmp/rope.vect"
+"$tk" tighten "$tmp/rope.vect" --vertices 80 --steps 1500 --escapes 0 --constrain 0:0=plane:1,0,0,-5 \
+    --constrain 0:39=plane:2,0,0,10 --json -o "$tmp/rope-out.vect" --struts "$tmp/rope-struts.json" \
+    >"$tmp/rope.json" 2>"$tmp/err"
+check $? "tighten --constrain: $(cat "$tmp/err")"
+close "$(value length "$tmp/rope.json")" 10 1e-6
+check $? "the rope between the planes is their distance: $(value length "$tmp/rope.json")"
+[ "$(grep -c '^# Constraint [12] Plane' "$tmp/rope-out.vect")" -eq 2 ] &&
+    [ "$(grep -c '# Cst: [12]$' "$tmp/rope-out.vect")" -eq 2 ]
+check $? "the output keeps its constraints: $(grep '#' "$tmp/rope-out.vect" | tr '\n' ' ')"
+node -e 'const s = JSON.parse(require("fs").readFileSync(process.argv[1], "utf8"));
+    process.exit(s.constraints.length === 2 && s.constraints.every((c) => Math.abs(c.force - 1) < 1e-6) &&
+        s.constraints[1].constraint === "0:79=plane:1,0,0,5" ? 0 : 1)' "$tmp/rope-struts.json"
+check $? "the ends' forces are the unit tension: $(cat "$tmp/rope-struts.json" | tr -d '\n' | cut -c1-300)"
+"$tk" tighten "$tmp/rope-out.vect" --steps 10 --escapes 0 --json >"$tmp/again.json" 2>"$tmp/err"
+close "$(value length "$tmp/again.json")" 10 1e-6
+check $? "tightened again from its output, the rope stays at 10: $(value length "$tmp/again.json") $(cat "$tmp/err")"
+"$tk" tighten "$tmp/rope.vect" --steps 10 --constrain 0:5=plane:0,0,1,7 >/dev/null 2>"$tmp/err"
+[ $? -eq 2 ] && grep -q "constraint 0:5=plane:0,0,1,7: its vertex is" "$tmp/err"
+check $? "a start off its constraint: exit 2, the constraint named: $(cat "$tmp/err")"
+"$tk" tighten "$tmp/rope.vect" --steps 10 --constrain 0:40=free >/dev/null 2>"$tmp/err"
+[ $? -eq 1 ] && grep -q "component 0 has no vertex 40" "$tmp/err"
+check $? "a constraint on a vertex that does not exist: usage error: $(cat "$tmp/err")"
+
 echo "cli-tighten: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
