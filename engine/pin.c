@@ -42,7 +42,7 @@ int tk_curve_pin_add(tk_curve *c, const tk_pin *pin, bool at_vertex, tk_error *e
         return tk_error_set(err, TK_EINVAL,
                             "constraint %zu:%zu: the curve has no component %zu (it has %zu)",
                             pin->comp, pin->vertex, pin->comp, c->ncomp);
-    size_t n = tk_curve_comp_vertices(c, pin->comp);
+    size_t n = c->offset[pin->comp + 1] - c->offset[pin->comp];
     if (pin->vertex >= n)
         return tk_error_set(err, TK_EINVAL,
                             "constraint %zu:%zu: component %zu has no vertex %zu (it has %zu)",

@@ -17,17 +17,20 @@ dir=$build/engine
 # The levels, lowest first.  The libraries (the curve, its geometry and
 # struts, the solvers, the invariants, the records, the file formats) hold
 # no run state and serve every room, so they all stand below the rooms;
-# among themselves only two that call each other are refused.  queries.c
-# (read-only questions on the run's state) and type.c (the knot type's
-# checks) serve every room from just above them.
+# among themselves only two that call each other are refused.  The
+# constraints on vertices (pin.c) are part of the curve's value, below
+# it: the curve carries them through its copies, resamplings and motions.
+# queries.c (read-only questions on the run's state) and type.c (the knot
+# type's checks) serve every room from just above the libraries.
 levels='
-0 curve geometry struts nnls rigidity invariants record error vect generate thickness relax
-1 queries type
-2 active
-3 motion
-4 stepping recovery
-5 schedule escape
-6 tighten
+0 pin error
+1 curve geometry struts nnls rigidity invariants record vect generate thickness relax
+2 queries type
+3 active
+4 motion
+5 stepping recovery
+6 schedule escape
+7 tighten
 '
 
 set -- "$dir"/*.o
