@@ -351,6 +351,10 @@ static int step(tk_run *r, tk_error *err)
     rc = tk_stepping_begin(r, &rep, err);
     tk_schedule_watch(r, tk_escape_judged_here(r));
     rc = tk_stepping_finish(r, &rep, rc, err);
+    /* a pinned vertex moves along its constraint only, but each step
+     * rounds: put back on it, it does not drift over many steps */
+    if (!rc && r->shared.curve->npins)
+        tk_curve_pins_snap(r->shared.curve);
     if (!rc)
         rc = figures(r, &rep, err);
     if (rc) {
