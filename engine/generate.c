@@ -18,6 +18,7 @@
 #include "rng.h"
 #include "tk/geometry.h"
 #include "tk/invariants.h"
+#include "tk/struts.h"
 #include "tk/thickness.h"
 
 /* Counts beyond which a generator refuses: the VECT reader's default
@@ -525,6 +526,9 @@ int tk_generate_deform(const tk_curve *src, unsigned long long seed, double keep
                 tk_invariants_compute(*out, &now, &why) == TK_OK &&
                 tk_invariants_compare(&type, &now, &why) == TK_OK;
         tk_invariants_free(&now);
+        /* and on the way: the invariants cannot tell every link apart */
+        if (found)
+            rc = tk_struts_path_embedded(src, *out, &found, err);
     }
     if (!rc && !found)
         rc = tk_error_set(err, TK_ENUMERIC, "no deformation of seed %llu keeps the type and "

@@ -1021,3 +1021,49 @@ int tk_kinks_find(const tk_curve *c, double bound, tk_kink **out, size_t *count,
     }
     return TK_OK;
 }
+
+/* The path is cut into pieces none of which moves a vertex by more than
+ * PATH_SHARE of the closest distance between two edges that are not
+ * neighbours at its start: a point of an edge moves no more than its
+ * vertices, so no such distance falls to 0 within the piece. */
+#define PATH_SHARE 0.45
+#define PATH_PIECES 2000
+
+int tk_struts_path_embedded(const tk_curve *a, const tk_curve *b, bool *embedded, tk_error *err)
+{
+    *embedded = false;
+    tk_curve *x = NULL;
+    tk_strut_finder *f = NULL;
+    int rc = tk_curve_copy(a, &x, err);
+    if (!rc)
+        rc = tk_strut_finder_new(a, &f, err);
+    double most = 0.0, shortest = 0.0;
+    for (size_t v = 0; !rc && v < a->nvert; v++) {
+        const double *p = tk_curve_vertex(a, v), *q = tk_curve_vertex(b, v);
+        double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+        most = fmax(most, sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+    }
+    if (!rc)
+        tk_curve_edge_range(a, &shortest, NULL);
+    /* the arc rule with a vanishing diameter: every vertex may turn by all
+     * but nothing of pi, so every pair of edges but neighbours is looked at */
+    double tiny = 1e-9 * shortest;
+    double s = 0.0;
+    for (int piece = 0; !rc && piece < PATH_PIECES; piece++) {
+        double dist;
+        rc = tk_strut_finder_closest_pair(f, x, TK_ARC_ADMISSIBLE, tiny, INFINITY, &dist, err);
+        if (rc || !(dist > 0.0))
+            break;
+        if (!(most > 0.0) || s + PATH_SHARE * dist / most >= 1.0) {
+            *embedded = true;
+            break;
+        }
+        s += PATH_SHARE * dist / most;
+        for (size_t i = 0; i < 3 * a->nvert; i++)
+            x->xyz[i] = a->xyz[i] + s * (b->xyz[i] - a->xyz[i]);
+        tk_strut_finder_refit(f, x);
+    }
+    tk_strut_finder_free(&f);
+    tk_curve_free(&x);
+    return rc;
+}

@@ -8,6 +8,7 @@
 #include "support.h"
 #include "tk/generate.h"
 #include "tk/geometry.h"
+#include "tk/invariants.h"
 #include "tk/struts.h"
 #include "tk/thickness.h"
 
@@ -516,6 +517,102 @@ START_TEST(kinks_of_a_polygon)
 }
 END_TEST
 
+/* The smallest distance between two edges that are not neighbours, by
+ * brute force over every pair. */
+static double closest_apart(const tk_curve *c)
+{
+    size_t ne = tk_curve_edge_count(c);
+    double best = INFINITY;
+    for (size_t i = 0; i < ne; i++)
+        for (size_t j = i + 1; j < ne; j++) {
+            tk_edge a = tk_curve_edge(c, i), b = tk_curve_edge(c, j);
+            if (a.head == b.head || a.head == b.tail || a.tail == b.head || a.tail == b.tail)
+                continue;
+            tk_closest cl;
+            tk_segment_closest(tk_curve_vertex(c, a.head), tk_curve_vertex(c, a.tail),
+                               tk_curve_vertex(c, b.head), tk_curve_vertex(c, b.tail), &cl);
+            best = fmin(best, cl.dist);
+        }
+    return best;
+}
+
+/* A straight path between two curves is an isotopy when no two edges
+ * meet on it: one ring pulled out of the Borromean rings through another
+ * is not (though every invariant the engine computes is the same at both
+ * ends), nor is a ring moved through another; small smooth deformations
+ * of a trefoil that it passes keep every pair of edges apart at every
+ * one of 400 points of the path, by brute force. */
+START_TEST(a_straight_path_is_an_isotopy_when_no_edges_meet)
+{
+    tk_curve *a = NULL, *b = NULL;
+    bool ok;
+    ck_assert_int_eq(tk_generate_borromean(96, &a, NULL), TK_OK);
+    ck_assert_int_eq(tk_curve_copy(a, &b, NULL), TK_OK);
+    for (size_t v = b->offset[0]; v < b->offset[1]; v++)
+        tk_curve_vertex(b, v)[0] += 6.0; /* ring 0 pulled 6 along x */
+    tk_invariants ta = TK_INVARIANTS_INIT, tb = TK_INVARIANTS_INIT;
+    ck_assert_int_eq(tk_invariants_compute(a, &ta, NULL), TK_OK);
+    ck_assert_int_eq(tk_invariants_compute(b, &tb, NULL), TK_OK);
+    ck_assert_int_eq(tk_invariants_compare(&ta, &tb, NULL), TK_OK); /* they cannot tell */
+    tk_invariants_free(&ta);
+    tk_invariants_free(&tb);
+    ck_assert_int_eq(tk_struts_path_embedded(a, b, &ok, NULL), TK_OK);
+    ck_assert(!ok);
+    /* a small move is one */
+    for (size_t v = b->offset[0]; v < b->offset[1]; v++)
+        tk_curve_vertex(b, v)[0] = tk_curve_vertex(a, v)[0] + 0.05;
+    ck_assert_int_eq(tk_struts_path_embedded(a, b, &ok, NULL), TK_OK);
+    ck_assert(ok);
+    tk_curve_free(&a);
+    tk_curve_free(&b);
+    /* two rings side by side, one moved through the other's strand */
+    size_t n[2] = {40, 40};
+    bool closed[2] = {true, true};
+    ck_assert_int_eq(tk_curve_new(&a, 2, n, closed, NULL), TK_OK);
+    for (size_t k = 0; k < 40; k++) {
+        double t = 2.0 * M_PI * (double)k / 40.0;
+        double *p = tk_curve_vertex(a, k), *q = tk_curve_vertex(a, 40 + k);
+        p[0] = cos(t), p[1] = sin(t), p[2] = 0.0;
+        q[0] = 3.0 + cos(t), q[1] = 0.0, q[2] = sin(t);
+    }
+    ck_assert_int_eq(tk_curve_copy(a, &b, NULL), TK_OK);
+    for (size_t k = 0; k < 40; k++)
+        tk_curve_vertex(b, 40 + k)[0] -= 2.0; /* its centre to (1, 0, 0): linked */
+    ck_assert_int_eq(tk_struts_path_embedded(a, b, &ok, NULL), TK_OK);
+    ck_assert(!ok);
+    tk_curve_free(&a);
+    tk_curve_free(&b);
+    /* smooth deformations of a trefoil, against brute force along the path */
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 60, &c, NULL), TK_OK);
+    int passed = 0;
+    for (unsigned seed = 1; seed <= 12; seed++) {
+        double coef[TK_DEFORM_MODES * 6];
+        tkt_rng rng = {seed};
+        for (size_t i = 0; i < sizeof coef / sizeof *coef; i++)
+            coef[i] = tkt_rng_range(&rng, -1.0, 1.0);
+        ck_assert_int_eq(tk_curve_copy(c, &b, NULL), TK_OK);
+        tk_generate_fourier(b, c, coef, TK_DEFORM_MODES, 0.3 * (double)seed);
+        ck_assert_int_eq(tk_struts_path_embedded(c, b, &ok, NULL), TK_OK);
+        if (ok) {
+            passed++;
+            tk_curve *x = NULL;
+            ck_assert_int_eq(tk_curve_copy(c, &x, NULL), TK_OK);
+            for (int k = 0; k <= 400; k++) {
+                double s = k / 400.0;
+                for (size_t i = 0; i < 3 * c->nvert; i++)
+                    x->xyz[i] = c->xyz[i] + s * (b->xyz[i] - c->xyz[i]);
+                ck_assert_msg(closest_apart(x) > 0.0, "seed %u: edges meet at %g", seed, s);
+            }
+            tk_curve_free(&x);
+        }
+        tk_curve_free(&b);
+    }
+    ck_assert_int_gt(passed, 0);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("struts");
@@ -534,6 +631,7 @@ int main(void)
     tcase_add_test(tc, nearly_touching_tips_far_from_the_origin);
     tcase_add_test(tc, refit_follows_moved_vertices);
     tcase_add_test(tc, kinks_of_a_polygon);
+    tcase_add_test(tc, a_straight_path_is_an_isotopy_when_no_edges_meet);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);
 }

@@ -74,8 +74,10 @@ void tk_generate_fourier(tk_curve *c, const tk_curve *from, const double *coef, 
 
 /* A start of another shape with src's type: the largest smooth
  * displacement (tk_generate_fourier, TK_DEFORM_MODES modes, normal
- * coefficients drawn from `seed`) that keeps src's knot or link type and
- * at least `keep` (in (0, 1]) of its thickness.  Its amplitude starts at
+ * coefficients drawn from `seed`) that keeps src's knot or link type, on
+ * the way from src too (tk_struts_path_embedded: the invariants cannot
+ * tell every link apart), and at least `keep` (in (0, 1]) of its
+ * thickness.  Its amplitude starts at
  * the mean radius of src's components taken as circles (L / 2 pi) and
  * shrinks by 0.7 until both hold: far from src at once, where the
  * strands leave room.  TK_ENUMERIC when no amplitude down to 1e-6 of the
