@@ -11,11 +11,55 @@
 
 #include "tk/curve.h"
 
-static const char *const KIND_NAME[] = {"free", "point", "plane", "line"};
+/* The kinds, in tk_pin_kind's order: their names and how many numbers. */
+static const struct {
+    const char *name;
+    int count;
+} KINDS[] = {{"free", 0}, {"point", 3}, {"plane", 4}, {"line", 6}};
+#define NKINDS (sizeof KINDS / sizeof *KINDS)
 
 const char *tk_pin_kind_name(tk_pin_kind kind)
 {
-    return (unsigned)kind < sizeof KIND_NAME / sizeof *KIND_NAME ? KIND_NAME[kind] : "?";
+    return (unsigned)kind < NKINDS ? KINDS[kind].name : "?";
+}
+
+int tk_pin_count(tk_pin_kind kind)
+{
+    return (unsigned)kind < NKINDS ? KINDS[kind].count : 0;
+}
+
+int tk_pin_kind_of(const char *name, size_t n)
+{
+    for (size_t k = 0; k < NKINDS; k++)
+        if (strlen(KINDS[k].name) == n && strncasecmp(name, KINDS[k].name, n) == 0)
+            return (int)k;
+    return -1;
+}
+
+void tk_pin_numbers(const tk_pin *pin, double v[6])
+{
+    if (pin->kind == TK_PIN_POINT) {
+        memcpy(v, pin->point, 3 * sizeof *v);
+    } else if (pin->kind == TK_PIN_PLANE) {
+        memcpy(v, pin->normal, 3 * sizeof *v);
+        v[3] = pin->offset;
+    } else if (pin->kind == TK_PIN_LINE) {
+        memcpy(v, pin->point, 3 * sizeof *v);
+        memcpy(v + 3, pin->normal, 3 * sizeof *v);
+    }
+}
+
+void tk_pin_set_numbers(tk_pin *pin, const double *v)
+{
+    if (pin->kind == TK_PIN_POINT) {
+        memcpy(pin->point, v, 3 * sizeof *v);
+    } else if (pin->kind == TK_PIN_PLANE) {
+        memcpy(pin->normal, v, 3 * sizeof *v);
+        pin->offset = v[3];
+    } else if (pin->kind == TK_PIN_LINE) {
+        memcpy(pin->point, v, 3 * sizeof *v);
+        memcpy(pin->normal, v + 3, 3 * sizeof *v);
+    }
 }
 
 static double dot3(const double *a, const double *b)
@@ -195,19 +239,6 @@ static bool numbers(const char **p, double *out, int count)
     return true;
 }
 
-static const struct {
-    const char *name;
-    tk_pin_kind kind;
-    int count; /* numbers after the name */
-    const char *form;
-} FORMS[] = {
-    {"free", TK_PIN_FREE, 0, "free"},
-    {"fixed", TK_PIN_POINT, 0, "fixed"},
-    {"point", TK_PIN_POINT, 3, "point:x,y,z"},
-    {"plane", TK_PIN_PLANE, 4, "plane:nx,ny,nz,d"},
-    {"line", TK_PIN_LINE, 6, "line:px,py,pz,tx,ty,tz"},
-};
-
 int tk_pin_parse(const char *text, tk_pin *out, bool *at_vertex, tk_error *err)
 {
     *out = (tk_pin){0};
@@ -231,62 +262,40 @@ int tk_pin_parse(const char *text, tk_pin *out, bool *at_vertex, tk_error *err)
                             text);
     out->comp = (size_t)comp;
     out->vertex = (size_t)vertex;
-    for (size_t f = 0; f < sizeof FORMS / sizeof *FORMS; f++) {
-        size_t len = strlen(FORMS[f].name);
-        if (strncasecmp(p, FORMS[f].name, len) != 0 ||
-            (p[len] != '\0' && p[len] != ':'))
-            continue;
-        out->kind = FORMS[f].kind;
-        *at_vertex = FORMS[f].count == 0 && FORMS[f].kind == TK_PIN_POINT;
-        const char *q = p + len;
-        double v[6];
-        bool good = FORMS[f].count == 0 ? *q == '\0'
-                                         : *q == ':' && (q++, numbers(&q, v, FORMS[f].count)) &&
-                                               *q == '\0';
-        if (!good)
-            return tk_error_set(err, TK_EINVAL, "constraint '%.64s': %s is written %s", text,
-                                FORMS[f].name, FORMS[f].form);
-        if (out->kind == TK_PIN_POINT && FORMS[f].count)
-            memcpy(out->point, v, 3 * sizeof *v);
-        if (out->kind == TK_PIN_PLANE) {
-            memcpy(out->normal, v, 3 * sizeof *v);
-            out->offset = v[3];
-        }
-        if (out->kind == TK_PIN_LINE) {
-            memcpy(out->point, v, 3 * sizeof *v);
-            memcpy(out->normal, v + 3, 3 * sizeof *v);
-        }
-        return TK_OK;
+    /* "fixed" is a point where the vertex is, without numbers */
+    size_t len = strcspn(p, ":");
+    bool fixed = len == 5 && strncasecmp(p, "fixed", 5) == 0;
+    int kind = fixed ? TK_PIN_POINT : tk_pin_kind_of(p, len);
+    if (kind < 0)
+        return tk_error_set(err, TK_EINVAL,
+                            "constraint '%.64s': the kind is free, fixed, point:x,y,z, "
+                            "plane:nx,ny,nz,d or line:px,py,pz,tx,ty,tz",
+                            text);
+    out->kind = (tk_pin_kind)kind;
+    *at_vertex = fixed;
+    int count = fixed ? 0 : KINDS[kind].count;
+    const char *q = p + len;
+    double v[6];
+    bool good = count == 0 ? *q == '\0' : *q == ':' && (q++, numbers(&q, v, count)) && *q == '\0';
+    if (!good) {
+        static const char *const form[] = {"free", "point:x,y,z", "plane:nx,ny,nz,d",
+                                           "line:px,py,pz,tx,ty,tz"};
+        return tk_error_set(err, TK_EINVAL, "constraint '%.64s': %s is written %s", text,
+                            fixed ? "fixed" : KINDS[kind].name, fixed ? "fixed" : form[kind]);
     }
-    return tk_error_set(err, TK_EINVAL,
-                        "constraint '%.64s': the kind is free, fixed, point:x,y,z, "
-                        "plane:nx,ny,nz,d or line:px,py,pz,tx,ty,tz",
-                        text);
+    if (count)
+        tk_pin_set_numbers(out, v);
+    return TK_OK;
 }
 
 int tk_pin_format(const tk_pin *pin, char *buf, size_t size)
 {
     int n = snprintf(buf, size, "%zu:%zu=%s", pin->comp, pin->vertex, tk_pin_kind_name(pin->kind));
     size_t at = n > 0 && (size_t)n < size ? (size_t)n : size;
-    const double *x = NULL;
     double v[6];
-    int count = 0;
-    if (pin->kind == TK_PIN_POINT) {
-        x = pin->point;
-        count = 3;
-    } else if (pin->kind == TK_PIN_PLANE) {
-        memcpy(v, pin->normal, 3 * sizeof *v);
-        v[3] = pin->offset;
-        x = v;
-        count = 4;
-    } else if (pin->kind == TK_PIN_LINE) {
-        memcpy(v, pin->point, 3 * sizeof *v);
-        memcpy(v + 3, pin->normal, 3 * sizeof *v);
-        x = v;
-        count = 6;
-    }
-    for (int k = 0; k < count && at < size; k++) {
-        int m = snprintf(buf + at, size - at, "%c%.17g", k == 0 ? ':' : ',', x[k]);
+    tk_pin_numbers(pin, v);
+    for (int k = 0; k < tk_pin_count(pin->kind) && at < size; k++) {
+        int m = snprintf(buf + at, size - at, "%c%.17g", k == 0 ? ':' : ',', v[k]);
         if (m < 0)
             return -1;
         n += m;

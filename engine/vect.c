@@ -17,6 +17,7 @@
 
 #include "tk/vect.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <locale.h>
 #include <math.h>
@@ -376,11 +377,6 @@ static const char CHANNEL[4] = {'r', 'g', 'b', 'a'};
 
 /* Parses the whole text into *out.  Counts are checked in text order so
  * that the first error reported is the first one a reader meets. */
-/* The VECT names of the kinds (tk_pin_kind order) and their numbers. */
-static const struct {
-    const char *name;
-    int count;
-} KINDS[] = {{"Free", 0}, {"Point", 3}, {"Plane", 4}, {"Line", 6}};
 
 /* Reads up to `most` numbers of a comment's text into v; how many. */
 static int comment_numbers(const char *p, size_t n, double *v, int most, bool *bad)
@@ -452,13 +448,11 @@ static int pin_of(parser *ps, tk_curve *c, const definition *def, size_t v, size
         p++;
         n--;
     }
-    int kind = -1;
+    /* (the comment runs to its line's end, not to a NUL) */
     size_t len = 0;
-    for (size_t i = 0; i < sizeof KINDS / sizeof *KINDS && kind < 0; i++) {
-        len = strlen(KINDS[i].name);
-        if (starts_with(p, n, KINDS[i].name) && (n == len || p[len] == ' ' || p[len] == '\t'))
-            kind = (int)i;
-    }
+    while (len < n && p[len] != ' ' && p[len] != '\t')
+        len++;
+    int kind = tk_pin_kind_of(p, len);
     if (kind < 0)
         return fail(ps, TK_EPARSE, def->d->line,
                     "constraint %ld: the kind is Plane a b c d, Point x y z, Line px py pz "
@@ -466,9 +460,9 @@ static int pin_of(parser *ps, tk_curve *c, const definition *def, size_t v, size
     double x[6];
     bool bad;
     int count = comment_numbers(p + len, n - len, x, 6, &bad);
-    if (bad || count != KINDS[kind].count)
+    if (bad || count != tk_pin_count((tk_pin_kind)kind))
         return fail(ps, TK_EPARSE, def->d->line, "constraint %ld: %s takes %d numbers", def->k,
-                    KINDS[kind].name, KINDS[kind].count);
+                    tk_pin_kind_name((tk_pin_kind)kind), tk_pin_count((tk_pin_kind)kind));
     /* the component holding v: the last whose offset is at most v */
     size_t lo = 0, hi = c->ncomp - 1;
     while (lo < hi) {
@@ -480,15 +474,7 @@ static int pin_of(parser *ps, tk_curve *c, const definition *def, size_t v, size
     }
     *pin = (tk_pin){.comp = lo, .vertex = v - c->offset[lo], .kind = (tk_pin_kind)kind,
                     .id = (int)def->k};
-    if (kind == TK_PIN_POINT) {
-        memcpy(pin->point, x, 3 * sizeof *x);
-    } else if (kind == TK_PIN_PLANE) {
-        memcpy(pin->normal, x, 3 * sizeof *x);
-        pin->offset = x[3];
-    } else if (kind == TK_PIN_LINE) {
-        memcpy(pin->point, x, 3 * sizeof *x);
-        memcpy(pin->normal, x + 3, 3 * sizeof *x);
-    }
+    tk_pin_set_numbers(pin, x);
     tk_error why;
     int rc = tk_curve_pin_add(c, pin, false, &why);
     return rc ? fail(ps, rc == TK_ENOMEM ? TK_ENOMEM : TK_EPARSE, use_line, "%s", why.message)
@@ -1005,17 +991,11 @@ static int write_vect(const tk_curve *c, FILE *f, tk_error *err)
     for (size_t i = 0; i < c->npins; i++) {
         const tk_pin *p = &c->pins[i];
         double v[6];
-        int count = KINDS[p->kind].count;
-        if (p->kind == TK_PIN_POINT) {
-            memcpy(v, p->point, 3 * sizeof *v);
-        } else if (p->kind == TK_PIN_PLANE) {
-            memcpy(v, p->normal, 3 * sizeof *v);
-            v[3] = p->offset;
-        } else if (p->kind == TK_PIN_LINE) {
-            memcpy(v, p->point, 3 * sizeof *v);
-            memcpy(v + 3, p->normal, 3 * sizeof *v);
-        }
-        if (fprintf(f, "# Constraint %zu %s", i + 1, KINDS[p->kind].name) < 0)
+        int count = tk_pin_count(p->kind);
+        tk_pin_numbers(p, v);
+        /* the kind capitalised, as the catalogue's clasp writes it */
+        const char *name = tk_pin_kind_name(p->kind);
+        if (fprintf(f, "# Constraint %zu %c%s", i + 1, toupper((unsigned char)name[0]), name + 1) < 0)
             goto io;
         for (int k = 0; k < count; k++)
             if (fprintf(f, " %.17g", v[k]) < 0)

@@ -223,7 +223,7 @@ START_TEST(vect_keeps_the_constraints)
     /* errors name the line */
     const char *bad[][2] = {
         {"VECT\n1 2 0\n2\n0\n# Constraint 1 Plane 0 0 1\n0 0 0 # Cst: 1\n1 0 0\n",
-         "line 5: constraint 1: Plane takes 4 numbers"},
+         "line 5: constraint 1: plane takes 4 numbers"},
         {"VECT\n1 2 0\n2\n0\n0 0 0 # Cst: 2\n1 0 0\n", "line 5: constraint 2 is not defined"},
         {"VECT\n1 2 0\n2\n0\n# Cst: 1\n# Constraint 1 Free\n0 0 0\n1 0 0\n",
          "line 5: '# Cst: 1' must follow the coordinates"},

@@ -85,4 +85,15 @@ int tk_pin_format(const tk_pin *pin, char *buf, size_t size);
 /* The kind's name: "free", "point", "plane", "line". */
 const char *tk_pin_kind_name(tk_pin_kind kind);
 
+/* A pin's numbers, the one layout its text and the VECT comment share:
+ * none (FREE), x y z (POINT), nx ny nz d (PLANE), px py pz tx ty tz
+ * (LINE).  tk_pin_count says how many, tk_pin_numbers writes them into v
+ * (6 at most), tk_pin_set_numbers sets the pin's from v. */
+int tk_pin_count(tk_pin_kind kind);
+void tk_pin_numbers(const tk_pin *pin, double v[6]);
+void tk_pin_set_numbers(tk_pin *pin, const double *v);
+
+/* The kind named `name` (any case), its first n bytes; -1 when none. */
+int tk_pin_kind_of(const char *name, size_t n);
+
 #endif
