@@ -173,8 +173,6 @@ static double resolution_final(const tk_run *r)
     return r->opt.resolution;
 }
 
-/* The vertices of the current coarse level at ropelength rope: with the
- * vertices option, exactly that count at the last level. */
 /* The fewest vertices the run's curve can have: 3 a closed component, 2
  * an open one.  An open rope pulled straight has a ropelength near 0 (its
  * thickness grows without bound), and its resolution would ask for none. */
@@ -186,6 +184,9 @@ static size_t least_count(const tk_run *r)
     return least;
 }
 
+/* The vertices of the current coarse level at ropelength rope: with the
+ * vertices option, exactly that count at the last level; never fewer
+ * than least_count. */
 static size_t level_count(const tk_run *r, double rope)
 {
     int level = r->schedule.coarse_level;
