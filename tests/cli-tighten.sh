@@ -335,6 +335,12 @@ check $? "the rope between the planes is their distance: $(value length "$tmp/ro
 [ "$(grep -c '^# Constraint [12] Plane' "$tmp/rope-out.vect")" -eq 2 ] &&
     [ "$(grep -c '# Cst: [12]$' "$tmp/rope-out.vect")" -eq 2 ]
 check $? "the output keeps its constraints: $(grep '#' "$tmp/rope-out.vect" | tr '\n' ' ')"
+"$tk" info --json "$tmp/rope-out.vect" >"$tmp/rope-info.json" 2>"$tmp/err" &&
+    node -e 'const i = JSON.parse(require("fs").readFileSync(process.argv[1], "utf8"));
+        process.exit(JSON.stringify(i.constraints) === JSON.stringify(["0:0=plane:1,0,0,-5", "0:79=plane:1,0,0,5"]) ? 0 : 1)' \
+        "$tmp/rope-info.json" &&
+    "$tk" info "$tmp/rope-out.vect" | grep -q ", 2 constrained vertices$"
+check $? "info lists them: $(cat "$tmp/rope-info.json" "$tmp/err")"
 node -e 'const s = JSON.parse(require("fs").readFileSync(process.argv[1], "utf8"));
     process.exit(s.constraints.length === 2 && s.constraints.every((c) => Math.abs(c.force - 1) < 1e-6) &&
         s.constraints[1].constraint === "0:79=plane:1,0,0,5" ? 0 : 1)' "$tmp/rope-struts.json"

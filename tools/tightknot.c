@@ -664,6 +664,15 @@ static int info_one(const char *name, const cli_args *a, int width, bool *header
         json_object_set_new(o, "struts", json_integer((json_int_t)struts.count));
         json_object_set_new(o, "kinks", json_integer((json_int_t)nkinks));
         json_object_set_new(o, "invariants", tk_json_invariants(typed ? &inv : NULL));
+        if (c->npins) { /* as --constrain writes them */
+            json_t *list = json_array();
+            for (size_t i = 0; i < c->npins; i++) {
+                char text[512];
+                tk_pin_format(&c->pins[i], text, sizeof text);
+                json_array_append_new(list, json_string(text));
+            }
+            json_object_set_new(o, "constraints", list);
+        }
         status = print_json(o);
     } else {
         if (!*header_done)
@@ -673,6 +682,8 @@ static int info_one(const char *name, const cli_args *a, int width, bool *header
                c->ncomp, c->nvert, m.length, m.thickness, m.minrad, m.ropelength,
                struts.count, nkinks);
         print_type(stdout, c, typed ? &inv : NULL);
+        if (c->npins)
+            printf(", %zu constrained vert%s", c->npins, c->npins == 1 ? "ex" : "ices");
         putchar('\n');
     }
     tk_invariants_free(&inv);
