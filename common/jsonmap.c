@@ -176,6 +176,17 @@ static double *edge_starts(const tk_curve *c, double *comp_start)
     return start;
 }
 
+/* A vertex's place along the components laid end to end: it starts edge
+ * `vertex` of its component; the last vertex of an open one ends the
+ * component. */
+static double vertex_along(const tk_curve *c, const double *start, const double *comp_start,
+                           size_t comp, size_t vertex)
+{
+    return vertex < tk_curve_comp_edges(c, comp)
+               ? start[tk_curve_comp_first_edge(c, comp) + vertex]
+               : comp_start[comp] + tk_curve_comp_length(c, comp);
+}
+
 json_t *tk_json_contacts(const tk_curve *c, const tk_strut *struts, size_t nstruts,
                          const tk_kink *kinks, size_t nkinks, bool with_force,
                          const double *pin_force)
@@ -229,18 +240,12 @@ json_t *tk_json_contacts(const tk_curve *c, const tk_strut *struts, size_t nstru
     }
     for (size_t i = 0; i < nkinks; i++) {
         const tk_kink *k = &kinks[i];
-        size_t e = tk_curve_comp_first_edge(c, k->comp) + k->vertex;
         json_t *j = json_object();
         json_object_set_new(j, "comp", json_integer((json_int_t)k->comp));
         json_object_set_new(j, "vertex", json_integer((json_int_t)k->vertex));
         json_object_set_new(j, "minrad", tk_json_number(k->minrad));
-        /* the vertex starts edge `vertex` of its component; the last
-         * vertex of an open one ends the component */
-        json_object_set_new(j, "arclength", tk_json_number(
-                                                k->vertex < tk_curve_comp_edges(c, k->comp)
-                                                    ? start[e]
-                                                    : comp_start[k->comp] +
-                                                          tk_curve_comp_length(c, k->comp)));
+        json_object_set_new(j, "arclength", tk_json_number(vertex_along(c, start, comp_start,
+                                                                         k->comp, k->vertex)));
         if (with_force)
             json_object_set_new(j, "force", tk_json_number(k->force));
         json_array_append_new(klist, j);
@@ -254,14 +259,10 @@ json_t *tk_json_contacts(const tk_curve *c, const tk_strut *struts, size_t nstru
             const tk_pin *p = &c->pins[i];
             char text[512];
             tk_pin_format(p, text, sizeof text);
-            /* the vertex's place along the components, as a kink's */
-            size_t e = tk_curve_comp_first_edge(c, p->comp) + p->vertex;
-            double along = p->vertex < tk_curve_comp_edges(c, p->comp)
-                               ? start[e]
-                               : comp_start[p->comp] + tk_curve_comp_length(c, p->comp);
             json_t *j = json_pack("{s:I, s:I, s:s, s:o}", "comp", (json_int_t)p->comp, "vertex",
                                   (json_int_t)p->vertex, "constraint", text, "arclength",
-                                  tk_json_number(along));
+                                  tk_json_number(vertex_along(c, start, comp_start, p->comp,
+                                                              p->vertex)));
             if (with_force && pin_force)
                 json_object_set_new(j, "force", tk_json_number(pin_force[i]));
             json_array_append_new(plist, j);

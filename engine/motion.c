@@ -300,10 +300,11 @@ int tk_run_pin_forces(const tk_run *r, double *force, tk_error *err)
     const tk_curve *c = r->shared.curve;
     const tk_constraints *set = &r->active.set;
     size_t n3 = 3 * c->nvert, ncon = set->struts.count + set->nkinks;
-    double *w = malloc(n3 * sizeof *w), *x = malloc((ncon ? ncon : 1) * sizeof *x);
+    double *w = malloc(n3 * sizeof *w), *ax = malloc(n3 * sizeof *ax);
+    double *x = malloc((ncon ? ncon : 1) * sizeof *x);
     cholmod_common *cc = tk_nnls_common(r->shared.nnls);
     cholmod_sparse *a = NULL;
-    int rc = w && x ? TK_OK : tk_error_set(err, TK_ENOMEM, "out of memory for the forces");
+    int rc = w && ax && x ? TK_OK : tk_error_set(err, TK_ENOMEM, "out of memory for the forces");
     if (!rc && ncon)
         rc = tk_rigidity_build_branches(c, set->struts.items, set->struts.count, set->kinks,
                                         set->kink_edge, set->nkinks, cc, &a, err);
@@ -316,11 +317,9 @@ int tk_run_pin_forces(const tk_run *r, double *force, tk_error *err)
         for (size_t k = 0; k < set->nkinks; k++)
             x[set->struts.count + k] = set->kinks[k].force;
         if (a) {
-            const int *colp = a->p, *row = a->i;
-            const double *val = a->x;
-            for (size_t j = 0; j < ncon; j++)
-                for (int k = colp[j]; k < colp[j + 1]; k++)
-                    w[row[k]] += val[k] * x[j];
+            multiply(a, x, ax, n3);
+            for (size_t i = 0; i < n3; i++)
+                w[i] += ax[i];
         }
         for (size_t i = 0; i < c->npins; i++) {
             const tk_pin *p = &c->pins[i];
@@ -333,6 +332,7 @@ int tk_run_pin_forces(const tk_run *r, double *force, tk_error *err)
     }
     cholmod_free_sparse(&a, cc);
     free(w);
+    free(ax);
     free(x);
     return rc;
 }

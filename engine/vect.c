@@ -472,8 +472,7 @@ static int pin_of(parser *ps, tk_curve *c, const definition *def, size_t v, size
         else
             hi = mid - 1;
     }
-    *pin = (tk_pin){.comp = lo, .vertex = v - c->offset[lo], .kind = (tk_pin_kind)kind,
-                    .id = (int)def->k};
+    *pin = (tk_pin){.comp = lo, .vertex = v - c->offset[lo], .kind = (tk_pin_kind)kind};
     tk_pin_set_numbers(pin, x);
     tk_error why;
     int rc = tk_curve_pin_add(c, pin, false, &why);

@@ -91,6 +91,18 @@ export function openPair(contacts) {
         (contacts.struts || []).every((s) => s.edges[0][0] !== s.edges[1][0]);
 }
 
+// One strut's mark on a contact map: a circle with its title, telling
+// onHover when the pointer is on it.
+function strutMark(cx, cy, r, fill, i, title, onHover) {
+    const mark = el('circle', { cx, cy, r, fill, class: 'strut-mark', 'data-index': i });
+    mark.append(el('title', {}, title));
+    if (onHover) {
+        mark.addEventListener('mouseenter', () => onHover(i));
+        mark.addEventListener('mouseleave', () => onHover(-1));
+    }
+    return mark;
+}
+
 // Zoomed on the contacts, as the paper's enlarged plot: both axes at one
 // scale, from a little before the first contact along each rope.
 function drawOpenPairMap(svg, contacts, { colour, onHover } = {}) {
@@ -129,12 +141,8 @@ function drawOpenPairMap(svg, contacts, { colour, onHover } = {}) {
     const out = [];
     struts.forEach((s, i) => {
         const [a, b] = ends[i];
-        const mark = el('circle', { cx: sx(a), cy: Y(b), r, fill: colour ? colour(s, i) : '#2563eb', class: 'strut-mark', 'data-index': i });
-        mark.append(el('title', {}, `strut ${i}: ${a.toFixed(3)} along component 0, ${b.toFixed(3)} along component 1, force ${fmtForce(s.force)}`));
-        if (onHover) {
-            mark.addEventListener('mouseenter', () => onHover(i));
-            mark.addEventListener('mouseleave', () => onHover(-1));
-        }
+        const mark = strutMark(sx(a), Y(b), r, colour ? colour(s, i) : '#2563eb', i,
+            `strut ${i}: ${a.toFixed(3)} along component 0, ${b.toFixed(3)} along component 1, force ${fmtForce(s.force)}`, onHover);
         svg.append(mark);
         out.push(mark);
     });
@@ -178,12 +186,8 @@ function drawWholeMap(svg, contacts, { colour, onHover } = {}) {
         const a = Math.min(a0, b0), b = Math.max(a0, b0);
         const fill = colour ? colour(s, i) : '#2563eb';
         mirrors.append(el('circle', { cx: sc(b), cy: Y(a), r, fill, class: 'strut-mirror' }));
-        const mark = el('circle', { cx: sc(a), cy: Y(b), r, fill, class: 'strut-mark', 'data-index': i });
-        mark.append(el('title', {}, `strut ${i}: ${a.toFixed(3)} – ${b.toFixed(3)}, force ${fmtForce(s.force)}`));
-        if (onHover) {
-            mark.addEventListener('mouseenter', () => onHover(i));
-            mark.addEventListener('mouseleave', () => onHover(-1));
-        }
+        const mark = strutMark(sc(a), Y(b), r, fill, i,
+            `strut ${i}: ${a.toFixed(3)} – ${b.toFixed(3)}, force ${fmtForce(s.force)}`, onHover);
         marks.append(mark);
         out.push(mark);
     });

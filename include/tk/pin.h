@@ -34,7 +34,6 @@ typedef struct tk_pin {
     double normal[3];    /* PLANE: unit normal n; LINE: unit direction t */
     double offset;       /* PLANE: d */
     double point[3];     /* POINT: the point; LINE: a point of the line */
-    int id;              /* the VECT file's constraint number (0: none) */
 } tk_pin;
 
 struct tk_curve;
