@@ -180,7 +180,7 @@ void tk_curve_pins_snap(tk_curve *c)
     }
 }
 
-int tk_curve_pins_settle(tk_curve *c, double tolerance, tk_error *err)
+int tk_curve_pins_check(const tk_curve *c, double tolerance, tk_error *err)
 {
     for (size_t i = 0; i < c->npins; i++) {
         double d = tk_pin_distance(c, &c->pins[i]);
@@ -193,8 +193,15 @@ int tk_curve_pins_settle(tk_curve *c, double tolerance, tk_error *err)
                                 text, d, tolerance);
         }
     }
-    tk_curve_pins_snap(c);
     return TK_OK;
+}
+
+int tk_curve_pins_settle(tk_curve *c, double tolerance, tk_error *err)
+{
+    int rc = tk_curve_pins_check(c, tolerance, err);
+    if (!rc)
+        tk_curve_pins_snap(c);
+    return rc;
 }
 
 void tk_pin_project(const tk_pin *pin, double v[3])

@@ -68,7 +68,7 @@ void tk_submission_clear(tk_submission *s);
 
 /* The submission's constraints on vertices added to its parsed curve c,
  * and every constraint of c (its VECT's too) checked against the start
- * as a run checks it (tk_curve_pins_settle): 422 naming the constraint
+ * as a run checks it (tk_curve_pins_check): 422 naming the constraint
  * otherwise.  *input is then the text to store: NULL when the VECT as
  * sent holds every constraint, else c written out with them (free()). */
 int tk_submission_pins(const tk_submission *s, tk_curve *c, char **input, tk_problem *p);

@@ -150,16 +150,11 @@ int tk_submission_pins(const tk_submission *s, tk_curve *c, char **input, tk_pro
                           err.message);
     }
     if (c->npins) {
-        /* as tk_run_new will: a rounding off is closed, farther is
-         * refused (on a copy: the run settles the curve as sent) */
+        /* as tk_run_new will (a rounding off is closed there, farther is
+         * refused), the curve left as sent */
         double shortest;
-        tk_curve *copy = NULL;
         tk_curve_edge_range(c, &shortest, NULL);
-        if (tk_curve_copy(c, &copy, &err))
-            return refuse(p, 503, NULL, NULL, "%s", err.message);
-        int rc = tk_curve_pins_settle(copy, TK_PIN_SETTLE * shortest, &err);
-        tk_curve_free(&copy);
-        if (rc)
+        if (tk_curve_pins_check(c, TK_PIN_SETTLE * shortest, &err))
             return refuse(p, 422, "field", "constraints", "%s", err.message);
     }
     if (json_array_size(s->constraints) && tk_vect_to_string(c, input, NULL, &err))

@@ -119,6 +119,9 @@ START_TEST(adding_checks_the_vertex_and_the_numbers)
     ck_assert(!memcmp(c->pins[1].point, tk_curve_vertex(c, 7), 3 * sizeof(double)));
     /* settling: a rounding away is closed, farther is refused naming it */
     pin(c, "0:19=plane:1,0,0,5.000001");
+    ck_assert_int_eq(tk_curve_pins_check(c, 1e-5, NULL), TK_OK);
+    ck_assert_double_eq(tk_curve_vertex(c, 19)[0], 5.0); /* checked, left as it is */
+    ck_assert_int_eq(tk_curve_pins_check(c, 1e-7, NULL), TK_EINVAL);
     ck_assert_int_eq(tk_curve_pins_settle(c, 1e-5, NULL), TK_OK);
     ck_assert_double_eq_tol(tk_curve_vertex(c, 19)[0], 5.000001, 1e-15);
     pin(c, "0:10=line:0,0,5,0,0,1");

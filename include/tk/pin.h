@@ -67,6 +67,8 @@ void tk_curve_pins_snap(struct tk_curve *c);
 /* A start's pins: every pinned vertex within `tolerance` of its constraint
  * is put on it; TK_EINVAL naming the first farther one and by how much. */
 int tk_curve_pins_settle(struct tk_curve *c, double tolerance, tk_error *err);
+/* The same check, the curve left as it is. */
+int tk_curve_pins_check(const struct tk_curve *c, double tolerance, tk_error *err);
 
 /* Projects a motion v of the pinned vertex onto the directions its pin
  * allows: nothing for a POINT, the plane's for a PLANE, the line's for a
