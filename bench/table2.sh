@@ -11,9 +11,11 @@
 # in length over its diameter (29.0030, half its ropelength 58.006).  The
 # clasp's row is the measure README.md ("The Gehring clasp") derives: the
 # two ropes' length beyond what their four planes take, L - (d1 + d2 + d3
-# + d4) over the diameter, d_i each plane's distance from the origin
-# after the run (the clasp file's planes bound a regular tetrahedron
-# about it); the paper's 4.2629 is another measure (see README.md).
+# + d4) over the diameter, d_i each end's plane offset after the run.
+# The paper's clasp is pulled over at right angles, its ends straight up
+# and down (`tightknot generate clasp`); the catalogue's simple_clasp.vect
+# pulls its ends toward the faces of a regular tetrahedron, another
+# clasp, and its row follows with no smooth value to compare.
 #
 # usage: bench/table2.sh [SECONDS] [BUILD_DIR] [CATALOGUE_DIR]
 #   SECONDS of processor time a link (default 600); two run at once.
@@ -26,6 +28,7 @@ tk=$build/tightknot
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 "$tk" generate chain 3 --vertices 384 >"$dir/chain3.vect"
+"$tk" generate clasp >"$dir/clasp.vect"
 
 run() { # tag file vertices
     start=$(date +%s.%N)
@@ -35,28 +38,31 @@ run() { # tag file vertices
     echo "$start $end" >"$dir/$1.wall"
 }
 
-run clasp "$catalogue/simple_clasp.vect" 332 &
+run clasp "$dir/clasp.vect" 332 &
 run hopf "$catalogue/2.2.1.vect" 216 &
 wait
 run chain "$dir/chain3.vect" 384 &
 run borromean "$catalogue/6.3.2.vect" 630 &
 wait
+run tetra "$catalogue/simple_clasp.vect" 332
 
-# the clasp's measure from its tightened file: the ropes' length less the
-# four planes' distances (the '# Constraint k Plane nx ny nz d' lines)
-clasp_measure() {
-    awk '/^# Constraint [0-9]+ Plane/ { d += $NF } END { printf "%.17g", d }' "$dir/clasp.out.vect"
+# a clasp's measure from its tightened file: the ropes' length less the
+# four planes' offsets (the '# Constraint k Plane nx ny nz d' lines)
+planes() {
+    awk '/^# Constraint [0-9]+ Plane/ { d += $NF } END { printf "%.17g", d }' "$dir/$1.out.vect"
 }
 
-node - "$dir" "$(clasp_measure)" <<'EOF'
-const [dir, planes] = process.argv.slice(2);
+node - "$dir" "$(planes clasp)" "$(planes tetra)" <<'EOF'
+const [dir, clasp, tetra] = process.argv.slice(2);
 const fs = require('fs');
+const planes = { clasp: Number(clasp), tetra: Number(tetra) };
 const rows = [
     // tag, name, paper's polygon value, smooth value, unit divisor of the ropelength
     ['clasp', 'Gehring clasp', 4.2636, 4.2629, null],
     ['hopf', 'Hopf link', 25.1406, 8 * Math.PI, 1],
     ['chain', 'chain of three', 41.7131, 12 * Math.PI + 4, 1],
     ['borromean', 'Borromean rings', 29.0096, 29.0030, 2],
+    ['tetra', 'simple_clasp', NaN, NaN, null],
 ];
 const pad = (s, n) => String(s).padEnd(n);
 console.log(['link', 'vertices', 'ours', 'paper', 'smooth', 'ours.err', 'paper.err', 'stopped', 'cpu.s', 'wall.s']
@@ -69,11 +75,12 @@ for (const [tag, name, paper, smooth, unit] of rows) {
         console.log(`${pad(name, 16)}failed: ${fs.readFileSync(`${dir}/${tag}.err`, 'utf8').trim()}`);
         continue;
     }
-    // the clasp: length over the diameter beyond its planes' reach
-    const ours = unit ? j.ropelength / unit : (j.length - Number(planes)) / (2 * j.options.radius);
+    // a clasp: length over the diameter beyond its planes' reach
+    const ours = unit ? j.ropelength / unit : (j.length - planes[tag]) / j.thickness;
     const [t0, t1] = fs.readFileSync(`${dir}/${tag}.wall`, 'utf8').trim().split(' ').map(Number);
-    const err = (x) => `${(100 * (x - smooth) / smooth).toFixed(4)}%`;
-    console.log([name, j.vertices, ours.toFixed(5), paper.toFixed(4), smooth.toFixed(4), err(ours),
+    const fixed = (x, k) => (Number.isNaN(x) ? '-' : x.toFixed(k));
+    const err = (x) => (Number.isNaN(smooth) ? '-' : `${(100 * (x - smooth) / smooth).toFixed(4)}%`);
+    console.log([name, j.vertices, ours.toFixed(5), fixed(paper, 4), fixed(smooth, 4), err(ours),
         err(paper), j.stop_reason, j.seconds.toFixed(1), (t1 - t0).toFixed(1)]
         .map((v, i) => pad(v, i ? 11 : 16)).join(''));
 }

@@ -1,7 +1,7 @@
 /* tightknot: example knots and links (include/tk/generate.h).
  *
- * Every generator samples a closed parametrised curve at equal parameter
- * steps.  Angles are evaluated by unit_circle(), which reduces k/n to the
+ * Every generator samples a parametrised curve at equal parameter steps
+ * (closed but for the clasp's ropes, sampled at equal arclength).  Angles are evaluated by unit_circle(), which reduces k/n to the
  * first quadrant in integers, so that points at multiples of pi/2 come out
  * exact (cos(M_PI) is -1 but sin(M_PI) is 1.2e-16): the Hopf link's vertex at
  * the other circle's centre is then exactly there, and the polygons keep the
@@ -18,6 +18,7 @@
 #include "rng.h"
 #include "tk/geometry.h"
 #include "tk/invariants.h"
+#include "tk/pin.h"
 #include "tk/struts.h"
 #include "tk/thickness.h"
 
@@ -288,6 +289,71 @@ int tk_generate_chain(size_t k, size_t vertices, tk_curve **out,
         }
     }
     return TK_OK;
+}
+
+/* Rope 0 of the clasp at arclength s: down the leg x = -CLASP_R from the
+ * plane z = CLASP_H, round the half circle about (0, 0, CLASP_C) in the
+ * plane y = 0, up the leg x = CLASP_R.  Rope 1 is its image under
+ * (x, 0, z) -> (0, x, -z). */
+#define CLASP_H 4.0
+#define CLASP_R 1.5
+#define CLASP_C 0.5
+
+static void clasp_point(double s, double p[3])
+{
+    double leg = CLASP_H - CLASP_C, arc = M_PI * CLASP_R;
+    if (s < leg) {
+        p[0] = -CLASP_R;
+        p[2] = CLASP_H - s;
+    } else if (s < leg + arc) {
+        double phi = -M_PI / 2.0 + (s - leg) / CLASP_R;
+        p[0] = CLASP_R * sin(phi);
+        p[2] = CLASP_C - CLASP_R * cos(phi);
+    } else {
+        p[0] = CLASP_R;
+        p[2] = CLASP_C + (s - leg - arc);
+    }
+    p[1] = 0.0;
+}
+
+int tk_generate_clasp(size_t vertices, tk_curve **out, tk_error *err)
+{
+    *out = NULL;
+    size_t n = vertices ? vertices : 64;
+    /* fewer and the half circle's chords cut in toward the other rope */
+    if (n < 16)
+        return tk_error_set(err, TK_EINVAL,
+                            "a clasp needs at least 16 vertices a rope (asked for %zu)", n);
+    if (n > MAX_TOTAL_VERTICES / 2)
+        return tk_error_set(err, TK_ELIMIT,
+                            "2 ropes of %zu vertices exceed the limit of %zu vertices", n,
+                            MAX_TOTAL_VERTICES);
+    size_t counts[2] = {n, n};
+    bool closed[2] = {false, false};
+    int rc = tk_curve_new(out, 2, counts, closed, err);
+    if (rc)
+        return rc;
+    tk_curve *c = *out;
+    double length = 2.0 * (CLASP_H - CLASP_C) + M_PI * CLASP_R;
+    for (size_t i = 0; i < n; i++) {
+        /* the last vertex exactly at the end of the second leg */
+        double s = i + 1 == n ? length : length * (double)i / (double)(n - 1), p[3];
+        clasp_point(s, p);
+        double *a = tk_curve_vertex(c, i), *b = tk_curve_vertex(c, n + i);
+        memcpy(a, p, sizeof p);
+        b[0] = 0.0;
+        b[1] = p[0];
+        b[2] = -p[2];
+    }
+    for (size_t comp = 0; comp < 2 && !rc; comp++)
+        for (size_t end = 0; end < 2 && !rc; end++) {
+            tk_pin pin = {.comp = comp, .vertex = end ? n - 1 : 0, .kind = TK_PIN_PLANE,
+                          .normal = {0.0, 0.0, comp ? -1.0 : 1.0}, .offset = CLASP_H};
+            rc = tk_curve_pin_add(c, &pin, false, err);
+        }
+    if (rc)
+        tk_curve_free(out);
+    return rc;
 }
 
 int tk_generate_figure_eight(size_t vertices, tk_curve **out, tk_error *err)

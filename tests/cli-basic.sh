@@ -100,7 +100,7 @@ done
 expect_match "^  remote " "$tmp/mainhelp" "tightknot --help lists remote"
 # every shape generate knows (one that it does not know is refused as
 # "unknown shape") is listed by tightknot --help
-for shape in torus figure-eight lissajous hopf borromean chain deform relax turn wander; do
+for shape in torus figure-eight lissajous hopf borromean chain clasp deform relax turn wander; do
     "$tk" generate "$shape" >/dev/null 2>"$tmp/shape"
     if grep -q "unknown shape" "$tmp/shape"; then
         fail "generate $shape: $(cat "$tmp/shape")"

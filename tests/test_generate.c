@@ -9,6 +9,7 @@
 #include "support.h"
 #include "tk/curve.h"
 #include "tk/generate.h"
+#include "tk/pin.h"
 #include "tk/invariants.h"
 #include "tk/thickness.h"
 
@@ -277,6 +278,44 @@ START_TEST(hopf_length_converges)
 }
 END_TEST
 
+/* The clasp: two open ropes of n vertices, their ends on the planes
+ * z = 4 and z = -4, each rope in its own plane, more than 1.5 apart, the
+ * measure of its half circles (2 (4 - 0.5) legs and a half circle of
+ * radius 1.5 each) in its length. */
+START_TEST(clasp_ropes)
+{
+    tk_curve *c = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_generate_clasp(0, &c, &err), TK_OK);
+    ck_assert_int_eq(tk_curve_validate(c, &err), TK_OK);
+    ck_assert_uint_eq(c->ncomp, 2);
+    for (size_t k = 0; k < 2; k++) {
+        ck_assert(!c->closed[k]);
+        ck_assert_uint_eq(tk_curve_comp_vertices(c, k), 64);
+        for (size_t v = c->offset[k]; v < c->offset[k + 1]; v++)
+            ck_assert_double_eq(tk_curve_vertex(c, v)[k ? 0 : 1], 0.0);
+    }
+    ck_assert_uint_eq(c->npins, 4);
+    for (size_t i = 0; i < 4; i++) {
+        ck_assert_int_eq(c->pins[i].kind, TK_PIN_PLANE);
+        ck_assert_double_eq(tk_pin_distance(c, &c->pins[i]), 0.0);
+        ck_assert_double_eq(c->pins[i].normal[2], c->pins[i].comp ? -1.0 : 1.0);
+    }
+    ck_assert_double_gt(min_between_components(c), 1.5);
+    /* the polygon's length: the legs' 14 and the chords of the half circles */
+    double length = 0.0;
+    for (size_t k = 0; k < 2; k++)
+        for (size_t v = c->offset[k] + 1; v < c->offset[k + 1]; v++)
+            length += dist3(tk_curve_vertex(c, v - 1), tk_curve_vertex(c, v));
+    ck_assert_double_lt(length, 2.0 * (7.0 + 1.5 * M_PI));
+    ck_assert_double_gt(length, 2.0 * (7.0 + 1.5 * M_PI) - 0.01);
+    tk_curve_free(&c);
+    ck_assert_int_eq(tk_generate_clasp(15, &c, &err), TK_EINVAL);
+    ck_assert_ptr_null(c);
+    ck_assert_int_eq(tk_generate_clasp(6000000, &c, &err), TK_ELIMIT);
+}
+END_TEST
+
 START_TEST(borromean_rings)
 {
     const size_t counts[] = {0, 3, 4, 7, 96};
@@ -478,6 +517,7 @@ static Suite *generate_suite(void)
     tcase_add_test(tc, hopf_geometry);
     tcase_add_test(tc, hopf_length_converges);
     tcase_add_test(tc, borromean_rings);
+    tcase_add_test(tc, clasp_ropes);
     tcase_add_test(tc, chain_rings);
     tcase_add_test(tc, invalid_arguments);
     tcase_add_test(tc, lissajous_curve);

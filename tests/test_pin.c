@@ -4,7 +4,9 @@
  * whose ends slide on them tightens to the planes' distance (an exact
  * value), its pinned ends on their planes at every step and through a
  * refinement, each end's force the rope's unit tension; the catalogue's
- * clasp is refused when a constraint is not met. */
+ * clasp is refused when a constraint is not met; the paper's clasp ends
+ * near the smooth value its criticality analysis gives, below the half
+ * circles, its tips apart. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -13,6 +15,7 @@
 
 #include "support.h"
 #include "tk/curve.h"
+#include "tk/generate.h"
 #include "tk/pin.h"
 #include "tk/struts.h"
 #include "tk/tighten.h"
@@ -370,6 +373,64 @@ START_TEST(the_clasp_s_ends_stay_on_their_planes)
 }
 END_TEST
 
+/* The paper's clasp (tk_generate_clasp: ends pulled straight up and
+ * down, Table 2's Gehring clasp).  Tightened, its measure, the ropes'
+ * length beyond their planes' offsets over the diameter, is below the
+ * 2 pi - 2 of two half circles about the tips and near the smooth
+ * 4.2629 of Cantarella, Fu, Kusner, Sullivan and Wrinkle (2006), and
+ * its tips are more than a diameter apart: the gap their criticality
+ * analysis found.  Each leg leaves its plane at a right angle. */
+START_TEST(the_paper_s_clasp_tightens_below_its_half_circles)
+{
+    tk_curve *c = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_generate_clasp(40, &c, &err), TK_OK);
+    ck_assert_uint_eq(c->npins, 4);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.max_steps = 3000;
+    tk_run *run = NULL;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    ck_assert_int_eq(tk_run_until(run, NULL, &err), TK_OK);
+    const tk_curve *fin = tk_run_curve(run);
+    const tk_step_report *s = tk_run_latest(run);
+    double offsets = 0.0;
+    for (size_t i = 0; i < fin->npins; i++)
+        offsets += fin->pins[i].offset;
+    double measure = (s->length - offsets) / s->thickness;
+    /* the tips: the lowest vertex of rope 0, the highest of rope 1 */
+    const double *tip[2] = {NULL, NULL};
+    for (size_t comp = 0; comp < 2; comp++)
+        for (size_t v = fin->offset[comp]; v < fin->offset[comp + 1]; v++) {
+            const double *p = tk_curve_vertex(fin, v);
+            if (!tip[comp] || (comp ? p[2] > tip[comp][2] : p[2] < tip[comp][2]))
+                tip[comp] = p;
+        }
+    double gap = sqrt(pow(tip[0][0] - tip[1][0], 2) + pow(tip[0][1] - tip[1][1], 2) +
+                      pow(tip[0][2] - tip[1][2], 2)) / s->thickness;
+    printf("paper's clasp: measure %.6f on %zu vertices after %ld steps (half circles "
+           "%.6f, smooth 4.2629), tips %.4f diameters apart\n",
+           measure, fin->nvert, s->step, 2.0 * M_PI - 2.0, gap);
+    ck_assert_double_lt(measure, 2.0 * M_PI - 2.0);
+    ck_assert_double_eq_tol(measure, 4.2629, 0.005 * 4.2629);
+    ck_assert_double_gt(gap, 1.01);
+    /* a leg meets its plane at a right angle: the end's edge along the
+     * plane's normal */
+    for (size_t i = 0; i < fin->npins; i++) {
+        const tk_pin *p = &fin->pins[i];
+        size_t v = fin->offset[p->comp] + p->vertex;
+        size_t w = p->vertex == 0 ? v + 1 : v - 1;
+        const double *a = tk_curve_vertex(fin, v), *b = tk_curve_vertex(fin, w);
+        double e[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+        double along = (e[0] * p->normal[0] + e[1] * p->normal[1] + e[2] * p->normal[2]) /
+                       sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+        ck_assert_double_gt(along, 1.0 - 1e-6);
+    }
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("pin");
@@ -383,6 +444,7 @@ int main(void)
     tcase_add_test(tc, a_rope_between_planes_tightens_to_their_distance);
     tcase_add_test(tc, a_clasp_off_its_plane_is_refused);
     tcase_add_test(tc, the_clasp_s_ends_stay_on_their_planes);
+    tcase_add_test(tc, the_paper_s_clasp_tightens_below_its_half_circles);
     suite_add_tcase(s, tc);
     return tkt_run_suite(s);
 }

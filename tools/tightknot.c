@@ -3,6 +3,7 @@
  *   tightknot info [--json] [--tolerance EPS] FILE...
  *   tightknot struts [--json] [--tolerance EPS] FILE
  *   tightknot generate torus P Q | figure-eight | lissajous NX NY NZ | hopf | borromean | chain K
+ *                      | clasp
  *                      | deform FILE [SEED] | relax FILE [STEPS]
  *                      | turn FILE [SEED] | wander FILE [SEED]
  *                      [--vertices N] [--disguise SEED]
@@ -71,7 +72,7 @@ static const char main_help[] =
     "  struts     the struts (self-contacts) and kinks of one VECT file\n"
     "  generate   write a knot or link as VECT on standard output: an example\n"
     "             (torus P Q, figure-eight, lissajous NX NY NZ, hopf,\n"
-    "             borromean, chain K) or a start of another shape with a\n"
+    "             borromean, chain K, clasp) or a start of another shape with a\n"
     "             file's type (deform FILE, relax FILE, turn FILE, wander FILE)\n"
     "  tighten    tighten a knot or link: shorten it keeping the tube embedded\n"
     "  remote     use a tightknot service: submit files, list, status, cancel,\n"
@@ -221,12 +222,16 @@ static const char generate_help[] =
     "              exactly, links of unknots included (closed components)\n"
     "  chain K     K >= 1 rings of radius 1, centres 1.5 apart on the x axis,\n"
     "              in alternating planes, each linked with its neighbours\n"
+    "  clasp       two open ropes hooked over each other at right angles,\n"
+    "              the ends of one sliding on the plane z = 4, of the other\n"
+    "              on z = -4 (the paper's Table 2 clasp; bench/table2.sh\n"
+    "              measures it)\n"
     "\n"
     "Options:\n"
     "  --vertices N   vertices per component (default: torus about 40 per\n"
     "                 turn, at least 60; figure-eight 200; lissajous 60 per\n"
     "                 turn of the fastest angle, at least 12; hopf 64;\n"
-    "                 borromean 96; chain 64).\n"
+    "                 borromean 96; chain 64; clasp 64 a rope).\n"
     "                 Too few to keep the polygon embedded is refused.\n"
     "  --disguise SEED   the same knot or link as another start would give\n"
     "                 it: vertices moved along each component to uneven\n"
@@ -876,7 +881,7 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
     const char *cmd = "generate";
     if (npos == 0)
         return usage_error(cmd, "no SHAPE given (torus P Q, figure-eight, lissajous NX NY NZ, "
-                                "hopf, borromean, chain K, deform FILE, relax FILE, turn FILE or wander FILE)");
+                                "hopf, borromean, chain K, clasp, deform FILE, relax FILE, turn FILE or wander FILE)");
     const char *shape = pos[0];
     tk_error err;
     tk_error_clear(&err);
@@ -890,11 +895,12 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
             return EXIT_USAGE;
         rc = tk_generate_torus((int)p, (int)q, vertices, out, &err);
     } else if (strcmp(shape, "hopf") == 0 || strcmp(shape, "borromean") == 0 ||
-               strcmp(shape, "figure-eight") == 0) {
+               strcmp(shape, "figure-eight") == 0 || strcmp(shape, "clasp") == 0) {
         if (npos != 1)
             return usage_error(cmd, "%s takes no arguments", shape);
         rc = shape[0] == 'h'   ? tk_generate_hopf(vertices, out, &err)
              : shape[0] == 'b' ? tk_generate_borromean(vertices, out, &err)
+             : shape[0] == 'c' ? tk_generate_clasp(vertices, out, &err)
                                : tk_generate_figure_eight(vertices, out, &err);
     } else if (strcmp(shape, "lissajous") == 0) {
         if (npos != 4 && npos != 7)
@@ -941,7 +947,7 @@ static int make_shape(int npos, char **pos, size_t vertices, tk_curve **out)
     } else {
         return usage_error(cmd,
                            "unknown shape '%s' (torus P Q, figure-eight, lissajous NX NY NZ, "
-                           "hopf, borromean, chain K, deform FILE, relax FILE, turn FILE or wander FILE)",
+                           "hopf, borromean, chain K, clasp, deform FILE, relax FILE, turn FILE or wander FILE)",
                            shape);
     }
     if (rc == TK_EINVAL || rc == TK_ELIMIT)

@@ -1,7 +1,7 @@
 /* tightknot: example knots and links, made by the project's own code.
  *
- * All generators produce closed, embedded polygons with vertices evenly
- * spaced in parameter; `vertices` is the count per component (0 = the
+ * All generators produce embedded polygons, closed but for the clasp's
+ * ropes, with vertices evenly spaced in parameter; `vertices` is the count per component (0 = the
  * generator's default).  These are the examples the project ships.
  */
 #ifndef TK_GENERATE_H
@@ -30,6 +30,20 @@ int tk_generate_borromean(size_t vertices, tk_curve **out, tk_error *err);
  * axis, in alternating planes, each linked with its neighbours only. */
 int tk_generate_chain(size_t k, size_t vertices, tk_curve **out,
                       tk_error *err);
+
+/* The clasp of the paper's Table 2 (its Figure 6): two open ropes of n
+ * vertices, each hooked over the other at right angles.  Rope 0 lies in
+ * the plane y = 0 and hangs from the plane z = 4 (both its ends slide on
+ * it: a plane pin n = (0, 0, 1), d = 4), rope 1 in the plane x = 0 stands
+ * on z = -4 (n = (0, 0, -1), d = 4).  Each is two straight legs 3 apart
+ * joined by a half circle of radius 1.5 round the z axis, the tips 2
+ * apart on it (rope 0's below), vertices at equal arclength; the ropes
+ * stay more than 1.5 apart.  Tightened, the ropes' length beyond the planes, L - (sum of
+ * the four ends' d), over the tube's diameter is the clasp's measure
+ * (2 pi - 2 for half circles about the tips; below that tight, as the
+ * tips part: Cantarella, Fu, Kusner, Sullivan and Wrinkle, 2006).  At
+ * least 16 vertices a rope (TK_EINVAL), default 64. */
+int tk_generate_clasp(size_t vertices, tk_curve **out, tk_error *err);
 
 /* The figure-eight knot as the closed curve
  *     ((2 + cos 2t) cos 3t, (2 + cos 2t) sin 3t, sin 4t), t in [0, 2 pi)
