@@ -33,9 +33,9 @@ int tk_generate_chain(size_t k, size_t vertices, tk_curve **out,
 
 /* The clasp of the paper's Table 2 (its Figure 6): two open ropes of n
  * vertices, each hooked over the other at right angles.  Rope 0 lies in
- * the plane y = 0 and hangs from the plane z = 4 (both its ends slide on
- * it: a plane pin n = (0, 0, 1), d = 4), rope 1 in the plane x = 0 stands
- * on z = -4 (n = (0, 0, -1), d = 4).  Each is two straight legs 3 apart
+ * the plane y = 0 and hangs from the plane z = 2.5 (both its ends slide on
+ * it: a plane pin n = (0, 0, 1), d = 2.5), rope 1 in the plane x = 0
+ * stands on z = -2.5 (n = (0, 0, -1), d = 2.5).  Each is two straight legs 3 apart
  * joined by a half circle of radius 1.5 round the z axis, the tips 2
  * apart on it (rope 0's below), vertices at equal arclength; the ropes
  * stay more than 1.5 apart.  Tightened, the ropes' length beyond the planes, L - (sum of
