@@ -1754,12 +1754,13 @@ END_TEST
  * ropelength reached when the run first refined (not the start's), and
  * keeps that count through the escapes, whose coarse polygons are
  * reckoned from the same ropelength; a run resumed during an escape
- * keeps it too.  T(2,5) on the round torus at resolution 5: its start is
- * half as long again as the tight knot. */
-START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
+ * keeps it too.  With the loose option the first tightening alone starts
+ * that many halvings below the coarse level (0.625 and 1.25 a unit for
+ * 2) and passes through them; the tries start on the coarse level.
+ * T(2,5) on the round torus at resolution 5: its start is half as long
+ * again as the tight knot. */
+static void loose_start_escapes(int loose, long steps)
 {
-    if (quick() && tkt_skip("a_loose_start_keeps_its_final_count_through_escapes", LONG_RUN))
-        return;
     tk_curve *c = NULL;
     ck_assert_int_eq(tk_generate_torus(2, 5, 200, &c, NULL), TK_OK);
     tk_measure m;
@@ -1767,15 +1768,18 @@ START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
     tk_options o = TK_OPTIONS_INIT;
     o.autoscale = true;
     o.resolution = 5;
+    o.loose = loose;
     o.escapes = 2;
     /* the second escape (after an explored one) starts before the last
-     * fifth: at step 10,215, the tries polished on their coarse polygons */
-    o.max_steps = 14000;
+     * fifth: at step 10,215 of 14,000 (loose 0), the tries polished on
+     * their coarse polygons; at 14,396 of 20,000 with loose 2 */
+    o.max_steps = steps;
     tk_run *run = NULL;
     tk_error err;
     ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    /* the first tightening starts on the loosest level */
     size_t coarse = tk_run_curve(run)->nvert;
-    ck_assert_uint_eq(coarse, (size_t)ceil(2.5 * m.ropelength));
+    ck_assert_uint_eq(coarse, (size_t)ceil(ldexp(2.5, -loose) * m.ropelength));
     size_t ne = 0, explored = 0;
     const tk_escape *e = tk_run_escapes(run, &ne);
     while (ne - explored < 2 && tk_run_latest(run)->step < o.max_steps) {
@@ -1784,11 +1788,16 @@ START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
         explored = ne > 0 && e[ne - 1].explored ? ne : explored;
     }
     ck_assert_uint_eq(ne - explored, 2);
-    double reference = final_reference(run, m.ropelength);
+    /* (the run's own: the first refinement may be a loose level's) */
+    tk_resume place;
+    tk_run_resume_point(run, &place);
+    double reference = place.final_ropelength;
+    if (!loose)
+        ck_assert_double_eq(reference, final_reference(run, m.ropelength));
     size_t final = (size_t)ceil(5 * reference), again = (size_t)ceil(2.5 * reference);
     size_t nh = 0;
     const tk_step_report *h = tk_run_history(run, &nh);
-    size_t restarts = 0, refinements = 0, plateau = 0;
+    size_t restarts = 0, refinements = 0, plateau = 0, loose_levels = 0;
     double lowest = INFINITY;
     for (size_t i = 1; i < nh; i++) {
         int k = h[i].escapes - 1;
@@ -1806,21 +1815,29 @@ START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
             /* exploring over: the lowest curve on its own ropelength's coarse polygon */
             lowest = fmin(lowest, e[k].coarse);
             ck_assert_uint_eq(h[i].vertices, (size_t)ceil(2.5 * lowest));
-        } else if (h[i].vertices < h[i - 1].vertices) {
-            /* the first coarse level following the ropelength down */
-            ck_assert_uint_eq(h[i].vertices, (size_t)ceil(2.5 * h[i - 1].ropelength));
+        } else if (h[i].vertices != h[i - 1].vertices && h[i].vertices != final) {
+            /* the first tightening's levels, loose and coarse: following
+             * the ropelength down or refined, at 0.625, 1.25 or 2.5 a
+             * unit of the ropelength before, never after an escape */
+            bool level = false;
+            for (double a = 0.625; a <= 2.5; a *= 2)
+                level = level || h[i].vertices == (size_t)ceil(a * h[i - 1].ropelength);
+            ck_assert_msg(level, "%zu vertices at ropelength %.4f", h[i].vertices,
+                          h[i - 1].ropelength);
             ck_assert_uint_eq(refinements, 0);
+            ck_assert_int_eq(h[i].escapes, 0);
+            loose_levels += h[i].vertices > h[i - 1].vertices;
         } else if (h[i].vertices > h[i - 1].vertices) {
-            ck_assert_uint_eq(h[i].vertices, final);
             refinements++;
         }
     }
-    printf("loose T(2,5): start ropelength %.2f, %zu vertices for it; final polygon %zu, "
+    printf("loose T(2,5), loose %d: start ropelength %.2f, %zu vertices for it; final polygon %zu, "
            "coarse %zu after %zu escapes (the second at step %ld), %zu refinements\n",
-           m.ropelength, (size_t)ceil(5 * m.ropelength), final, again, restarts,
+           loose, m.ropelength, (size_t)ceil(5 * m.ropelength), final, again, restarts,
            tk_run_latest(run)->step, refinements);
     ck_assert_uint_lt(final, (size_t)ceil(5 * m.ropelength) * 3 / 4);
     ck_assert_uint_eq(restarts, 2);
+    ck_assert_uint_eq(loose_levels, (size_t)loose); /* refined from each to the next */
     printf("explored tries: %zu; the lowest explored ropelength %.6f\n", explored, lowest);
     /* resumed during the second escape, it ends on the same polygon */
     tk_resume at;
@@ -1830,6 +1847,21 @@ START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
     ck_assert_uint_eq(tk_run_curve(second)->nvert, final);
     tk_run_free(&second);
     tk_curve_free(&c);
+}
+
+START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
+{
+    if (quick() && tkt_skip("a_loose_start_keeps_its_final_count_through_escapes", LONG_RUN))
+        return;
+    loose_start_escapes(0, 14000);
+}
+END_TEST
+
+START_TEST(loose_levels_come_first_and_tries_start_coarse)
+{
+    if (quick() && tkt_skip("loose_levels_come_first_and_tries_start_coarse", LONG_RUN))
+        return;
+    loose_start_escapes(2, 20000);
 }
 END_TEST
 
@@ -2608,6 +2640,7 @@ int main(void)
     tcase_add_test(tc, a_refined_tight_polygon_is_restored_without_rescaling);
     tcase_add_test(tc, a_loose_curve_is_kept_at_the_tube);
     tcase_add_test(tc, a_loose_start_keeps_its_final_count_through_escapes);
+    tcase_add_test(tc, loose_levels_come_first_and_tries_start_coarse);
     tcase_add_test(tc, a_loose_coarse_level_follows_the_ropelength);
     tcase_add_test(tc, a_loose_start_at_a_vertex_count_escapes_coarse);
     tcase_add_test(tc, a_fine_coarse_level_waits_as_many_more_steps);

@@ -124,6 +124,11 @@
       "with a resolution: start with half the vertices (a quarter, ... while 2.5 per unit "  \
       "ropelength remain), fewer each time the ropelength falls by a quarter, and double "   \
       "them whenever it all but stops falling")                                              \
+    X(loose, INT, 0, 0, 2, "loose",                                                          \
+      "with a resolution: the first tightening starts this many halvings below the "        \
+      "coarsest level, while 0.6 vertices a unit of ropelength remain, each left at its "    \
+      "first stall (a loose start comes down about four times as fast on each); tries "      \
+      "still start on the coarsest level (0 to 2)")                                          \
     X(escapes, INT, 8, 0, 1000, "escapes",                                                   \
       "most escapes: each time the ropelength all but stops falling on the final polygon "   \
       "(or has crawled there for a fifth of the budget) before the last fifth of the "       \
