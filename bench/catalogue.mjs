@@ -39,6 +39,8 @@
 //   --far K           far starts per knot (generate wander), seeds 1..K (default 1)
 //   --turn K          turned starts per knot, seeds 0..K-1 (default 1)
 //   --parallel N      starts running at once (default: the cores)
+//   --loose K         the run option loose (0 to 2, default 0): the first
+//                     tightening starts K halvings below the coarse level
 //   --out DIR         work directory (default build/catalogue)
 //   --table FILE      the table (default docs/catalogue.tsv)
 //   --build DIR       the programs (default build)
@@ -54,7 +56,7 @@ const argv = process.argv.slice(2);
 const opt = {
     server: null, token: process.env.TIGHTKNOT_TOKEN ?? null, slice: '1/1', seconds: 60,
     resolution: 5, far: 1, turn: 1, parallel: cpus().length, out: 'build/catalogue',
-    table: 'docs/catalogue.tsv', build: 'build', only: null, tableOnly: false,
+    table: 'docs/catalogue.tsv', build: 'build', only: null, tableOnly: false, loose: 0,
     catalogue: '../shared/catalogue',
 };
 for (let i = 0; i < argv.length; i++) {
@@ -71,6 +73,7 @@ for (let i = 0; i < argv.length; i++) {
     else if (a === '--far') opt.far = Number(value());
     else if (a === '--turn') opt.turn = Number(value());
     else if (a === '--parallel') opt.parallel = Number(value());
+    else if (a === '--loose') opt.loose = Number(value());
     else if (a === '--out') opt.out = value();
     else if (a === '--table') opt.table = value();
     else if (a === '--build') opt.build = value();
@@ -86,6 +89,11 @@ for (const k of ['seconds', 'resolution', 'parallel'])
     if (!(opt[k] > 0)) usage(`--${k} must be positive`);
 if (!(Number.isInteger(opt.far) && opt.far >= 0)) usage('--far must be a whole number >= 0');
 if (!(Number.isInteger(opt.turn) && opt.turn >= 0)) usage('--turn must be a whole number >= 0');
+if (!(Number.isInteger(opt.loose) && opt.loose >= 0 && opt.loose <= 2)) usage('--loose must be 0, 1 or 2');
+// the settings a slice ran with, kept beside its results: the table's
+// rows carry their own slice's
+const SETTINGS = `resolution ${opt.resolution}, ${opt.seconds} s of processor time a start, autoscale, `
+    + `default escapes${opt.loose ? `, loose ${opt.loose}` : ''}`;
 
 function usage(why) {
     const text = readFileSync(new URL(import.meta.url), 'utf8').split('\n');
@@ -213,11 +221,15 @@ async function ownDaemon() {
 }
 
 async function submitAll(server, files) {
+    const kept = join(resultsDir, 'settings.txt');
+    if (existsSync(kept) && readFileSync(kept, 'utf8').trim() !== SETTINGS)
+        usage(`${resultsDir} holds results made with other settings (${readFileSync(kept, 'utf8').trim()})`);
+    writeFileSync(kept, `${SETTINGS}\n`);
     // autoscale: a deformed start is thinner than the tube (ropelength
     // does not depend on the scale)
     const args = ['remote', '--server', server, 'submit', '--resolution', String(opt.resolution),
         '--time', String(opt.seconds), '--cpu-time', '--autoscale', '--parallel', String(opt.parallel),
-        '--out', resultsDir, ...files];
+        ...(opt.loose ? ['--loose', String(opt.loose)] : []), '--out', resultsDir, ...files];
     if (opt.token) args.splice(3, 0, '--token', opt.token);
     const child = spawn(CLI, args, { stdio: 'inherit' });
     return new Promise((res) => child.on('exit', (code) => res(code)));
@@ -273,7 +285,16 @@ function writeTable() {
     }
     // (slices run before cpu_time ran alone on the machine, where the wall
     // clock and the processor's agree)
-    const settings = `resolution ${opt.resolution}, ${opt.seconds} s of processor time a start, autoscale, default escapes`;
+    // a slice's own settings (settings.txt), else those of the slices
+    // before it was kept: these options without loose
+    const settingsOf = (dir) => {
+        try {
+            return readFileSync(join(dir, 'settings.txt'), 'utf8').trim();
+        } catch {
+            return `resolution ${opt.resolution}, ${opt.seconds} s of processor time a start, autoscale, default escapes`;
+        }
+    };
+    const settingsSeen = new Set();
     const lines = [['name', 'components', 'type', 'vertices', 'starts', 'lowest', 'lowest.start',
         'spread.%', 'cat.above.%', 'lowest.reached', 'struts', 'kinks', 'seconds', 'failed', 'type.changed',
         'unconverged', 'settings'].join('\t')];
@@ -320,7 +341,8 @@ function writeTable() {
             best.reached, best.struts, kinksOf(`${knot}@${best.tag}`, best.dir),
             ok.reduce((t, s) => t + s.seconds, 0).toFixed(0), failed.length,
             want ? changed.join(' ') || 'none' : '', unconverged.map((s) => s.tag).join(' '),
-            settings].join('\t'));
+            settingsOf(best.dir)].join('\t'));
+        settingsSeen.add(settingsOf(best.dir));
         summary.knots++;
         if (converged.length > 1) summary.compared++;
         if (converged.length > 1 && spread <= 0.1) summary.agree++;
@@ -330,7 +352,7 @@ function writeTable() {
     mkdirSync(resolve(opt.table, '..'), { recursive: true });
     writeFileSync(opt.table, lines.join('\n') + '\n');
     const pct = (n) => (summary.knots ? (100 * n / summary.knots).toFixed(1) : '-');
-    console.log(`table: ${opt.table}, ${summary.knots} of ${knots.length} knots and links (${settings})`);
+    console.log(`table: ${opt.table}, ${summary.knots} of ${knots.length} knots and links (${[...settingsSeen].join('; ')})`);
     console.log(`  with two converged starts or more: ${summary.compared}; every converged start within ` +
         `0.1% of the lowest: ${summary.agree} (${summary.compared ? (100 * summary.agree / summary.compared).toFixed(1) : '-'}%)`);
     console.log(`  starts still moving when their time ran out (residual >= ${CONVERGED}): ` +
