@@ -1,7 +1,8 @@
 /* tightknot: example knots and links (include/tk/generate.h).
  *
  * Every generator samples a parametrised curve at equal parameter steps
- * (closed but for the clasp's ropes, sampled at equal arclength).  Angles are evaluated by unit_circle(), which reduces k/n to the
+ * (closed but for the clasp's ropes, sampled at equal arclength).
+ * Angles are evaluated by unit_circle(), which reduces k/n to the
  * first quadrant in integers, so that points at multiples of pi/2 come out
  * exact (cos(M_PI) is -1 but sin(M_PI) is 1.2e-16): the Hopf link's vertex at
  * the other circle's centre is then exactly there, and the polygons keep the
@@ -294,11 +295,10 @@ int tk_generate_chain(size_t k, size_t vertices, tk_curve **out,
 /* Rope 0 of the clasp at arclength s: down the leg x = -CLASP_R from the
  * plane z = CLASP_H, round the half circle about (0, 0, CLASP_C) in the
  * plane y = 0, up the leg x = CLASP_R.  Rope 1 is its image under
- * (x, 0, z) -> (0, x, -z). */
-/* The planes as near as leaves the legs straight: the measure does not
- * depend on where they are, and vertices on a leg do nothing for it.  At
- * 332 vertices (600 s of processor time) planes at 4 gave 4.26460, at
- * 2.5 4.26353, half of each rope on its curved part instead of 48%. */
+ * (x, 0, z) -> (0, x, -z).  The planes are as near as leaves the legs
+ * straight: the measure does not depend on where they are, and vertices
+ * on a leg do nothing for it.  At 332 vertices (600 s of processor time)
+ * planes at 4 gave 4.26460, at 2.5 4.26353. */
 #define CLASP_H 2.5
 #define CLASP_R 1.5
 #define CLASP_C 0.5
