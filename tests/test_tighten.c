@@ -1817,10 +1817,11 @@ static void loose_start_escapes(int loose, long steps)
             ck_assert_uint_eq(h[i].vertices, (size_t)ceil(2.5 * lowest));
         } else if (h[i].vertices != h[i - 1].vertices && h[i].vertices != final) {
             /* the first tightening's levels, loose and coarse: following
-             * the ropelength down or refined, at 0.625, 1.25 or 2.5 a
-             * unit of the ropelength before, never after an escape */
+             * the ropelength down or refined, at 2.5 a unit of the
+             * ropelength before or a loose level's fewer (0.625, 1.25),
+             * never after an escape */
             bool level = false;
-            for (double a = 0.625; a <= 2.5; a *= 2)
+            for (double a = ldexp(2.5, -loose); a <= 2.5; a *= 2)
                 level = level || h[i].vertices == (size_t)ceil(a * h[i - 1].ropelength);
             ck_assert_msg(level, "%zu vertices at ropelength %.4f", h[i].vertices,
                           h[i - 1].ropelength);
