@@ -92,8 +92,9 @@ if (!(Number.isInteger(opt.turn) && opt.turn >= 0)) usage('--turn must be a whol
 if (!(Number.isInteger(opt.loose) && opt.loose >= 0 && opt.loose <= 2)) usage('--loose must be 0, 1 or 2');
 // the settings a slice ran with, kept beside its results: the table's
 // rows carry their own slice's
-const SETTINGS = `resolution ${opt.resolution}, ${opt.seconds} s of processor time a start, autoscale, `
-    + `default escapes${opt.loose ? `, loose ${opt.loose}` : ''}`;
+const settingsText = (loose) => `resolution ${opt.resolution}, ${opt.seconds} s of processor time `
+    + `a start, autoscale, default escapes${loose ? `, loose ${loose}` : ''}`;
+const SETTINGS = settingsText(opt.loose);
 
 function usage(why) {
     const text = readFileSync(new URL(import.meta.url), 'utf8').split('\n');
@@ -291,7 +292,7 @@ function writeTable() {
         try {
             return readFileSync(join(dir, 'settings.txt'), 'utf8').trim();
         } catch {
-            return `resolution ${opt.resolution}, ${opt.seconds} s of processor time a start, autoscale, default escapes`;
+            return settingsText(0);
         }
     };
     const settingsSeen = new Set();
@@ -342,7 +343,7 @@ function writeTable() {
             ok.reduce((t, s) => t + s.seconds, 0).toFixed(0), failed.length,
             want ? changed.join(' ') || 'none' : '', unconverged.map((s) => s.tag).join(' '),
             settingsOf(best.dir)].join('\t'));
-        settingsSeen.add(settingsOf(best.dir));
+        settingsSeen.add(lines.at(-1).split('\t').at(-1));
         summary.knots++;
         if (converged.length > 1) summary.compared++;
         if (converged.length > 1 && spread <= 0.1) summary.agree++;
