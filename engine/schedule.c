@@ -277,17 +277,24 @@ int tk_schedule_fit(tk_run *r, tk_error *err)
     return TK_OK;
 }
 
+/* How many times `resolution` halves and stays at or above `floor`, at
+ * most `most`. */
+static int halvings(double resolution, double floor, int most)
+{
+    int level = 0;
+    while (level < most && ldexp(resolution, -(level + 1)) >= floor)
+        level++;
+    return level;
+}
+
 /* The coarse levels below a final polygon of `resolution` vertices per
  * unit ropelength. */
 static int levels_below(const tk_run *r, double resolution)
 {
     const tk_options *o = &r->opt;
-    int level = 0;
     if (resolution > 0.0 && o->coarse_to_fine && o->snapshot_every == 0)
-        while (level < MAX_COARSE_LEVELS &&
-               ldexp(resolution, -(level + 1)) >= COARSEST_RESOLUTION)
-            level++;
-    return level;
+        return halvings(resolution, COARSEST_RESOLUTION, MAX_COARSE_LEVELS);
+    return 0;
 }
 
 /* The levels a run starts with (prepare_curve); the start's ropelength
@@ -302,13 +309,10 @@ static int coarse_levels(const tk_run *r)
  * tightening's alone, before any restart. */
 static int loose_levels(const tk_run *r)
 {
-    int levels = r->schedule.coarse_levels, loose = 0;
+    int levels = r->schedule.coarse_levels;
     if (levels == 0 || r->schedule.restarts > 0)
         return 0;
-    double coarsest = ldexp(resolution_final(r), -levels);
-    while (loose < r->opt.loose && ldexp(coarsest, -(loose + 1)) >= LOOSE_RESOLUTION)
-        loose++;
-    return loose;
+    return halvings(ldexp(resolution_final(r), -levels), LOOSE_RESOLUTION, r->opt.loose);
 }
 
 /* Fixes the ropelength the final polygon is reckoned from: when the run
