@@ -17,8 +17,8 @@
  * 90% of the thickness and no coarse restart both ended back in the same
  * configuration (48.208, 55.13).  The deformation's size is the largest
  * (from one diameter down by 0.7 each time) that keeps the knot type and
- * three quarters of the thickness (a near escape: every even try) or a
- * twentieth of it (a far one: every odd try).  A far escape loosens the
+ * three quarters of the thickness (a near escape) or a twentieth of it
+ * (a far one); the kinds take turns (try_curve).  A far escape loosens the
  * knot many times over, and its tightening from there can find another
  * basin: catalogue 6.1 at 186 vertices settles at 57.733 (+1.8% over the
  * atlas's 6_1), as does a copy of it doubled in size and deformed down
@@ -297,8 +297,8 @@ static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far,
     return rc;
 }
 
-/* The kinds of tries, in turn: a near deformation, the best turned
- * inside out (tk_relax_turn), a far deformation.  Deformations, near or
+/* The kinds of tries, in turn: the best turned inside out
+ * (tk_relax_turn), a far deformation, a near one.  Deformations, near or
  * far, stay in the strands' arrangement: catalogue 10.124 at resolution 5
  * (120 s) settled at 71.128 and its 13 tries in 600 s all came back
  * within 0.01%, as did starts deformed far from it (71.127) and relaxed
@@ -308,8 +308,16 @@ static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far,
  * 10.124 is T(3,5), and what the file's curve winds around, turned, it
  * winds around the other way.  About points near the centroid, 2 turns of
  * 7 reached that basin, 3 a basin between (71.20), none of 10 pulled far
- * off by tk_relax's isotopy. */
-enum { TRY_NEAR, TRY_TURNED, TRY_FAR, TRY_KINDS };
+ * off by tk_relax's isotopy.  The turn comes first: a knot of 9 or 10
+ * crossings gets two or three tries in 60 s, and with the near one first
+ * the catalogue's 9.38, 10.110 and 10.148 tried only near ones and ended
+ * at 82.88, 96.13 and 83.59 (resolution 5, loose 2), their first turned
+ * try at 81.83, 90.04 and 79.37.  A turned or far try starts on the
+ * loose levels (the loose option) as a loose start does, and is judged
+ * on the coarsest level as every try is: catalogue 10.70 (near tries
+ * first) ended at 91.64, still falling, with its turned try started on
+ * the coarsest level, and at 89.25 with it started on the loose levels. */
+enum { TRY_TURNED, TRY_FAR, TRY_NEAR, TRY_KINDS };
 
 /* The turned curve is relaxed on TURN_RESOLUTION vertices a unit of
  * ropelength, for TURN_STEPS steps (about 2 s for 10.124's 107). */
@@ -327,7 +335,8 @@ enum { TRY_NEAR, TRY_TURNED, TRY_FAR, TRY_KINDS };
  * about the centroid at 71.00266 and 71.00279 (each through a turned try
  * on the final polygon, from 71.058). */
 static int try_curve(tk_run *r, const tk_curve *best, double thickness, double rope, int index,
-                     tk_curve **out, double *amplitude, bool *turned, tk_error *err)
+                     tk_curve **out, double *amplitude, bool *turned, bool *loose,
+                     tk_error *err)
 {
     int kind = index % TRY_KINDS;
     *turned = false;
@@ -335,6 +344,7 @@ static int try_curve(tk_run *r, const tk_curve *best, double thickness, double r
      * behind: a far deformation instead */
     if (kind == TRY_TURNED && best->npins)
         kind = TRY_FAR;
+    *loose = kind != TRY_NEAR;
     if (kind != TRY_TURNED)
         return deformed(r, best, thickness, kind == TRY_FAR, out, amplitude, err);
     double offset[3];
@@ -471,12 +481,13 @@ static int explore_next(tk_run *r, tk_error *err)
         /* (resolved, the first plateau is found again on that polygon) */
         rc = tk_curve_copy(r->escape.explored, &curve, err);
         tk_curve_free(&r->escape.explored);
-        return rc ? rc : tk_schedule_explore(r, curve, r->escape.explored_rope, err);
+        return rc ? rc : tk_schedule_explore(r, curve, r->escape.explored_rope, false, err);
     }
     double amplitude = 0.0;
     bool turned = false;
+    bool loose = false;
     rc = try_curve(r, r->escape.explored, r->escape.explored_thickness, r->escape.explored_rope,
-                   r->escape.explore_tries, &curve, &amplitude, &turned, err);
+                   r->escape.explore_tries, &curve, &amplitude, &turned, &loose, err);
     tk_escape *e = rc ? NULL : log_entry(r, err);
     if (!e) {
         tk_curve_free(&curve);
@@ -494,7 +505,7 @@ static int explore_next(tk_run *r, tk_error *err)
     };
     r->escape.explore_tries++;
     /* a turned curve comes on its own vertices: onto the coarsest polygon */
-    return tk_schedule_explore(r, curve, e->turned ? r->escape.explored_rope : 0.0, err);
+    return tk_schedule_explore(r, curve, e->turned ? r->escape.explored_rope : 0.0, loose, err);
 }
 
 /* A try is judged where it leaves its coarsest polygon, against where the
@@ -565,13 +576,13 @@ int tk_escape_before_step(tk_run *r, tk_error *err)
          * is behind: polish the best (what it reaches is not the try's) */
         r->escape.polishing = true;
         int rc = tk_curve_copy(r->escape.best, &curve, err);
-        return rc ? rc : tk_schedule_restart(r, curve, false, r->escape.best_polish, err);
+        return rc ? rc : tk_schedule_restart(r, curve, false, false, r->escape.best_polish, err);
     }
     double amplitude = 0.0;
     int fine = tk_escape_tries(r) - r->escape.explore_tries;
-    bool turned = false;
+    bool turned = false, loose = false;
     int rc = try_curve(r, r->escape.best, r->escape.best_report.thickness,
-                       r->escape.best_report.ropelength, fine, &curve, &amplitude, &turned,
+                       r->escape.best_report.ropelength, fine, &curve, &amplitude, &turned, &loose,
                        err);
     tk_escape *e = rc ? NULL : log_entry(r, err);
     if (!e) {
@@ -589,7 +600,7 @@ int tk_escape_before_step(tk_run *r, tk_error *err)
         .improved = false,
         .turned = turned,
     };
-    return tk_schedule_restart(r, curve, true, 0, err);
+    return tk_schedule_restart(r, curve, true, loose, 0, err);
 }
 
 int tk_escape_finish(tk_run *r, bool *restored, tk_error *err)
@@ -613,7 +624,7 @@ int tk_escape_finish(tk_run *r, bool *restored, tk_error *err)
     tk_curve *curve = NULL;
     rc = tk_curve_copy(r->escape.best, &curve, err);
     if (!rc)
-        rc = tk_schedule_restart(r, curve, false, r->escape.best_polish, err);
+        rc = tk_schedule_restart(r, curve, false, false, r->escape.best_polish, err);
     *restored = rc == TK_OK;
     return rc;
 }

@@ -188,6 +188,8 @@ struct tk_run {
         double share_from;   /* budget spent when the current schedule began
                                 (an escape starts it again) */
         int restarts;        /* tk_schedule_restart's curves taken */
+        int loose;           /* loose levels of the current schedule (the
+                                first tightening's, or a loose try's) */
     } schedule;
 
     struct {             /* escape.c */
@@ -468,11 +470,12 @@ int tk_schedule_fit(tk_run *r, tk_error *err);
  * it), else `curve` is on the final polygon (the escapes' best): it keeps
  * its vertices, the schedule is at the final level and the polishing
  * level is `polish`; made feasible by scaling, type-checked. */
-int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_error *err);
+int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, bool loose, int polish,
+                        tk_error *err);
 /* The same on the coarsest level before the final polygon is fixed (the
  * escapes' exploration): `curve` resampled to that level's vertices at
  * ropelength `rope`, or kept as it is with 0. */
-int tk_schedule_explore(tk_run *r, tk_curve *curve, double rope, tk_error *err);
+int tk_schedule_explore(tk_run *r, tk_curve *curve, double rope, bool loose, tk_error *err);
 /* The vertices of the coarsest level at ropelength `rope`. */
 size_t tk_schedule_coarsest_count(tk_run *r, double rope);
 /* The fraction of the step or time budget spent (0 without one). */

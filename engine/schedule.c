@@ -304,13 +304,13 @@ static int coarse_levels(const tk_run *r)
     return levels_below(r, resolution_final(r));
 }
 
-/* The loose levels below the coarsest one of a run that has coarse levels
- * (the loose option, while LOOSE_RESOLUTION remains); the first
- * tightening's alone, before any restart. */
+/* The loose levels below the coarsest one that a schedule beginning now
+ * gets, for a run that has coarse levels (the loose option, while
+ * LOOSE_RESOLUTION remains). */
 static int loose_levels(const tk_run *r)
 {
     int levels = r->schedule.coarse_levels;
-    if (levels == 0 || r->schedule.restarts > 0)
+    if (levels == 0)
         return 0;
     return halvings(ldexp(resolution_final(r), -levels), LOOSE_RESOLUTION, r->opt.loose);
 }
@@ -369,7 +369,8 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
                                 r->opt.resolution, r->schedule.start_ropelength, want,
                                 TK_RUN_MAX_VERTICES);
         r->schedule.coarse_levels = coarse_levels(r);
-        r->schedule.coarse_level = r->schedule.coarse_levels + loose_levels(r);
+        r->schedule.loose = loose_levels(r);
+        r->schedule.coarse_level = r->schedule.coarse_levels + r->schedule.loose;
         tk_curve *resampled = NULL;
         rc = tk_curve_resample_total(*curve, level_count(r, r->schedule.start_ropelength),
                                      &resampled, err);
@@ -428,11 +429,14 @@ int tk_schedule_resume(tk_run *r, const tk_curve *curve, const tk_resume *at, tk
         at->coarse_level > r->schedule.coarse_levels && at->coarse_level <= MAX_COARSE_LEVELS)
         r->schedule.coarse_levels = at->coarse_level;
     r->schedule.restarts = at->restarts;
-    int loose = loose_levels(r);
-    if (at->coarse_level > r->schedule.coarse_levels + loose)
+    r->schedule.loose = at->loose;
+    if (at->loose > loose_levels(r) ||
+        at->coarse_level > r->schedule.coarse_levels + r->schedule.loose)
         return tk_error_set(err, TK_EINVAL,
-                            "the run resumes at coarse level %d, but its options have %d",
-                            at->coarse_level, r->schedule.coarse_levels + loose);
+                            "the run resumes at coarse level %d with %d loose levels, but its "
+                            "options have %d and %d",
+                            at->coarse_level, at->loose,
+                            r->schedule.coarse_levels + loose_levels(r), loose_levels(r));
     r->schedule.coarse_level = at->coarse_level;
     r->schedule.polish_level = at->polish_level;
     r->schedule.share_from = at->share_from;
@@ -452,6 +456,7 @@ void tk_schedule_resume_point(const tk_run *r, tk_resume *out)
 {
     out->start_ropelength = r->schedule.start_ropelength;
     out->coarse_level = r->schedule.coarse_level;
+    out->loose = r->schedule.loose;
     out->polish_level = r->schedule.polish_level;
     out->share_from = r->schedule.share_from;
     out->restarts = r->schedule.restarts;
@@ -534,6 +539,10 @@ static int refine(tk_run *r, tk_error *err)
     r->schedule.move_on = false;
     r->schedule.coarse_level--;
     double rope = reference_ropelength(r);
+    /* a loose level's count, as a loose try's start (go_loose), from the
+     * curve's own ropelength where that is the larger */
+    if (r->schedule.coarse_level > r->schedule.coarse_levels && r->life.latest.ropelength > rope)
+        rope = r->life.latest.ropelength;
     if (r->schedule.coarse_level == 0 && !(r->schedule.final_ropelength > 0.0))
         fix_final(r, rope);
     return resample_to(r, level_count(r, rope), err);
@@ -561,7 +570,7 @@ bool tk_schedule_share_spent(const tk_run *r)
     /* the shares of what was left when this schedule began */
     double from = r->schedule.share_from;
     double spent = from < 1.0 ? (tk_schedule_spent(r) - from) / (1.0 - from) : 1.0;
-    int levels = r->schedule.coarse_levels + loose_levels(r);
+    int levels = r->schedule.coarse_levels + r->schedule.loose;
     return spent >= (double)(levels - r->schedule.coarse_level + 1) / (double)(levels + 1);
 }
 
@@ -594,14 +603,62 @@ static int restart(tk_run *r, tk_curve *curve, size_t count, int polish, tk_erro
     return resampled ? TK_OK : tk_type_check(r, "an escape's deformation", err);
 }
 
-int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, int polish, tk_error *err)
+/* A loose try (turned inside out, or deformed far) restarts on the loose
+ * levels, as a loose start does, if its resampled curve keeps the type;
+ * else on the coarsest level (*count, already that level's).  The count
+ * is reckoned from the try's own ropelength where that is the larger: a
+ * turned trefoil (ropelength 32.8 before) resampled to 21 vertices at
+ * 0.625 a unit of 32.8 lost its type. */
+static int go_loose(tk_run *r, const tk_curve *curve, double rope, size_t *count, tk_error *err)
+{
+    int loose = loose_levels(r);
+    if (loose == 0)
+        return TK_OK;
+    tk_measure m;
+    int rc = measure(curve, &m, err);
+    if (rc)
+        return rc;
+    r->schedule.coarse_level = r->schedule.coarse_levels + loose;
+    size_t want = level_count(r, fmax(rope, reckoned_ropelength(&m)));
+    tk_curve *resampled = NULL;
+    tk_invariants type = TK_INVARIANTS_INIT;
+    tk_error why;
+    rc = tk_curve_resample_total(curve, want, &resampled, err);
+    if (rc)
+        return rc;
+    double t0 = tk_clock();
+    int type_rc = tk_invariants_compute(resampled, &type, &why);
+    if (type_rc == TK_ENOMEM)
+        rc = tk_error_set(err, type_rc, "%s", why.message);
+    else if (!type_rc)
+        type_rc = tk_invariants_compare(&r->type.start, &type, &why);
+    r->type.seconds += tk_clock() - t0;
+    tk_invariants_free(&type);
+    tk_curve_free(&resampled);
+    if (!rc && !type_rc) {
+        r->schedule.loose = loose;
+        *count = want;
+    } else {
+        r->schedule.coarse_level = r->schedule.coarse_levels;
+    }
+    return rc;
+}
+
+int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, bool loose, int polish,
+                        tk_error *err)
 {
     size_t count = curve->nvert;
     if (coarse && !(r->schedule.final_ropelength > 0.0))
         fix_final(r, reference_ropelength(r));
+    r->schedule.loose = 0;
     if (coarse && r->schedule.coarse_levels > 0) {
         r->schedule.coarse_level = r->schedule.coarse_levels;
         count = level_count(r, reference_ropelength(r));
+        int rc = loose ? go_loose(r, curve, reference_ropelength(r), &count, err) : TK_OK;
+        if (rc) {
+            tk_curve_free(&curve);
+            return rc;
+        }
     }
     /* The best curve put back is on the final polygon, whatever level the
      * try it replaces had reached: left at the try's, catalogue 3.1 at
@@ -624,10 +681,16 @@ size_t tk_schedule_coarsest_count(tk_run *r, double rope)
     return count;
 }
 
-int tk_schedule_explore(tk_run *r, tk_curve *curve, double rope, tk_error *err)
+int tk_schedule_explore(tk_run *r, tk_curve *curve, double rope, bool loose, tk_error *err)
 {
-    size_t count = rope > 0.0 ? tk_schedule_coarsest_count(r, rope) : curve->nvert;
+    r->schedule.loose = 0;
     r->schedule.coarse_level = r->schedule.coarse_levels;
+    size_t count = rope > 0.0 ? level_count(r, rope) : curve->nvert;
+    int rc = loose ? go_loose(r, curve, rope, &count, err) : TK_OK;
+    if (rc) {
+        tk_curve_free(&curve);
+        return rc;
+    }
     return restart(r, curve, count, 0, err);
 }
 

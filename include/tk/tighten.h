@@ -124,17 +124,17 @@
       "with a resolution: start with half the vertices (a quarter, ... while 2.5 per unit "  \
       "ropelength remain), fewer each time the ropelength falls by a quarter, and double "   \
       "them whenever it all but stops falling")                                              \
-    X(loose, INT, 0, 0, 2, "loose",                                                          \
+    X(loose, INT, 2, 0, 2, "loose",                                                          \
       "with a resolution: the first tightening starts this many halvings below the "        \
       "coarsest level, while 0.6 vertices a unit of ropelength remain, each left at its "    \
-      "first stall (a loose start comes down about four times as fast on each); tries "      \
-      "still start on the coarsest level (0 to 2)")                                          \
+      "first stall (a loose start comes down about four times as fast on each); so do "      \
+      "the escapes' turned and far tries (0 to 2)")                                          \
     X(escapes, INT, 8, 0, 1000, "escapes",                                                   \
       "most escapes: each time the ropelength all but stops falling on the final polygon "   \
       "(or has crawled there for a fifth of the budget) before the last fifth of the "       \
-      "budget, the best curve so far is changed at random (in turn: deformed a little, "     \
-      "turned inside out about a point near its centre, deformed and loosened many times " \
-      "over) and tightened again; the last fifth polishes the best curve; the "              \
+      "budget, the best curve so far is changed at random (in turn: turned inside out "      \
+      "about a point near its centre, deformed and loosened many times over, deformed a "    \
+      "little) and tightened again; the last fifth polishes the best curve; the "            \
       "result is the best curve found; before that, in the first quarter of the budget, "    \
       "as many tries again explore the coarsest polygon alone, from the lowest curve found " \
       "there (0: none)")                                                                     \
@@ -355,6 +355,7 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out);
       "the ropelength of the input, before any resampling")                                  \
     X(coarse_level, INT, 0, 0, 64, "coarse_level", "halvings of the vertex count still to "  \
       "undo")                                                                                \
+    X(loose, INT, 0, 0, 2, "loose", "loose levels of the current schedule")                  \
     X(polish_level, INT, 0, 0, 1000, "polish_level", "times the ropelength has all but "     \
       "stopped falling on this polygon")                                                     \
     X(share_from, REAL, 0, 0, 1e9, "share_from",                                             \
