@@ -39,8 +39,11 @@
 //   --far K           far starts per knot (generate wander), seeds 1..K (default 1)
 //   --turn K          turned starts per knot, seeds 0..K-1 (default 1)
 //   --parallel N      starts running at once (default: the cores)
-//   --loose K         the run option loose (0 to 2, default 0): the first
-//                     tightening starts K halvings below the coarse level
+//   --loose K         the run option loose (0 to 2, default 2): the first
+//                     tightening and the loose tries start K halvings below
+//                     the coarse level
+//   --engine ID       the engine's name in the settings column (default: the
+//                     last commit that changed engine/ or include/tk/)
 //   --out DIR         work directory (default build/catalogue)
 //   --table FILE      the table (default docs/catalogue.tsv)
 //   --build DIR       the programs (default build)
@@ -50,13 +53,14 @@
 import { execFileSync, spawn, spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, readdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { cpus } from 'node:os';
-import { join, resolve } from 'node:path';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
 
 const argv = process.argv.slice(2);
 const opt = {
     server: null, token: process.env.TIGHTKNOT_TOKEN ?? null, slice: '1/1', seconds: 60,
     resolution: 5, far: 1, turn: 1, parallel: cpus().length, out: 'build/catalogue',
-    table: 'docs/catalogue.tsv', build: 'build', only: null, tableOnly: false, loose: 0,
+    table: 'docs/catalogue.tsv', build: 'build', only: null, tableOnly: false, loose: 2, engine: null,
     catalogue: '../shared/catalogue',
 };
 for (let i = 0; i < argv.length; i++) {
@@ -74,6 +78,7 @@ for (let i = 0; i < argv.length; i++) {
     else if (a === '--turn') opt.turn = Number(value());
     else if (a === '--parallel') opt.parallel = Number(value());
     else if (a === '--loose') opt.loose = Number(value());
+    else if (a === '--engine') opt.engine = value();
     else if (a === '--out') opt.out = value();
     else if (a === '--table') opt.table = value();
     else if (a === '--build') opt.build = value();
@@ -92,9 +97,14 @@ if (!(Number.isInteger(opt.turn) && opt.turn >= 0)) usage('--turn must be a whol
 if (!(Number.isInteger(opt.loose) && opt.loose >= 0 && opt.loose <= 2)) usage('--loose must be 0, 1 or 2');
 // the settings a slice ran with, kept beside its results: the table's
 // rows carry their own slice's
-const settingsText = (loose) => `resolution ${opt.resolution}, ${opt.seconds} s of processor time `
-    + `a start, autoscale, default escapes${loose ? `, loose ${loose}` : ''}`;
-const SETTINGS = settingsText(opt.loose);
+const settingsText = (loose, engine) => `resolution ${opt.resolution}, ${opt.seconds} s of processor time `
+    + `a start, autoscale, default escapes${loose ? `, loose ${loose}` : ''}${engine ? `, engine ${engine}` : ''}`;
+if (opt.engine === null) {
+    const git = spawnSync('git', ['log', '-1', '--format=%h', '--', 'engine', 'include/tk'],
+        { encoding: 'utf8', cwd: dirname(fileURLToPath(import.meta.url)) });
+    opt.engine = git.status === 0 ? git.stdout.trim() : '';
+}
+const SETTINGS = settingsText(opt.loose, opt.engine);
 
 function usage(why) {
     const text = readFileSync(new URL(import.meta.url), 'utf8').split('\n');
@@ -230,7 +240,7 @@ async function submitAll(server, files) {
     // does not depend on the scale)
     const args = ['remote', '--server', server, 'submit', '--resolution', String(opt.resolution),
         '--time', String(opt.seconds), '--cpu-time', '--autoscale', '--parallel', String(opt.parallel),
-        ...(opt.loose ? ['--loose', String(opt.loose)] : []), '--out', resultsDir, ...files];
+        '--loose', String(opt.loose), '--out', resultsDir, ...files];
     if (opt.token) args.splice(3, 0, '--token', opt.token);
     const child = spawn(CLI, args, { stdio: 'inherit' });
     return new Promise((res) => child.on('exit', (code) => res(code)));
