@@ -310,7 +310,7 @@ function writeTable() {
         'spread.%', 'cat.above.%', 'lowest.reached', 'struts', 'kinks', 'seconds', 'failed', 'type.changed',
         'unconverged', 'settings'].join('\t')];
     const summary = { knots: 0, compared: 0, agree: 0, spreads: [], catTrapped: [], failed: [], changed: [],
-        unconverged: [] };
+        unconverged: [], bySettings: new Map() };
     for (const knot of [...byKnot.keys()].sort(natural)) {
         const starts = byKnot.get(knot).sort((a, b) => natural(a.tag, b.tag));
         const ok = starts.filter((s) => s.state === 'done' && Number.isFinite(s.ropelength));
@@ -353,7 +353,14 @@ function writeTable() {
             ok.reduce((t, s) => t + s.seconds, 0).toFixed(0), failed.length,
             want ? changed.join(' ') || 'none' : '', unconverged.map((s) => s.tag).join(' '),
             settingsOf(best.dir)].join('\t'));
-        settingsSeen.add(lines.at(-1).split('\t').at(-1));
+        const settings = lines.at(-1).split('\t').at(-1);
+        settingsSeen.add(settings);
+        if (!summary.bySettings.has(settings)) summary.bySettings.set(settings, { knots: 0, compared: 0, agree: 0, catTrapped: 0 });
+        const group = summary.bySettings.get(settings);
+        group.knots++;
+        group.compared += converged.length > 1;
+        group.agree += converged.length > 1 && spread <= 0.1;
+        group.catTrapped += catAbove > 0.1;
         summary.knots++;
         if (converged.length > 1) summary.compared++;
         if (converged.length > 1 && spread <= 0.1) summary.agree++;
@@ -372,6 +379,18 @@ function writeTable() {
         `(${pct(summary.catTrapped.length)}%)` + (summary.catTrapped.length
         ? `, by ${Math.min(...summary.catTrapped.map((t) => t[0])).toFixed(2)}% to ` +
           `${Math.max(...summary.catTrapped.map((t) => t[0])).toFixed(2)}%` : ''));
+    for (const [settings, g] of summary.bySettings)
+        console.log(`  ${settings}: ${g.knots} knots, ${g.agree} of ${g.compared} with two converged starts ` +
+            `or more within 0.1%; the catalogue's start more than 0.1% above the lowest in ${g.catTrapped}`);
+    // the daemon's figures of every slice run (daemon.tsv: wall seconds,
+    // jobs ended, workers' busy seconds, workers, from its /metrics)
+    const runs = readdirSync(resultsRoot).map((dir) => join(resultsRoot, dir, 'daemon.tsv')).filter(existsSync)
+        .flatMap((path) => readFileSync(path, 'utf8').trim().split('\n').map((l) => l.split('\t').map(Number)));
+    if (runs.length) {
+        const [wall, ended, busy, slots] = runs.reduce((t, r) => [t[0] + r[0], t[1] + r[1], t[2] + r[2], t[3] + r[0] * r[3]], [0, 0, 0, 0]);
+        console.log(`  the daemon, over ${runs.length} slice runs with its figures: ${ended} jobs in ${(wall / 3600).toFixed(2)} h ` +
+            `(${(ended / (wall / 3600)).toFixed(1)} jobs an hour), workers busy ${(100 * busy / slots).toFixed(1)}% of the time`);
+    }
     const widest = summary.spreads.sort((a, b) => b[0] - a[0]).slice(0, 10).filter((s) => s[0] > 0.1);
     for (const [spread, knot, lo, lov, hi, hiv] of widest)
         console.log(`  ${knot}: ${spread.toFixed(3)}% apart (${lo} ${lov.toFixed(4)}, ${hi} ${hiv.toFixed(4)})`);
@@ -391,8 +410,22 @@ if (!opt.tableOnly) {
         `${opt.parallel} at once`);
     let daemon = null;
     const server = opt.server ?? (daemon = await ownDaemon()).url;
+    const metric = async (name) => {
+        const text = await fetch(`${server}/metrics`).then((r) => r.text()).catch(() => '');
+        const m = new RegExp(`^tightknot_${name} (\\S+)$`, 'm').exec(text);
+        return m ? Number(m[1]) : NaN;
+    };
+    const before = { ended: await metric('jobs_ended_total'), busy: await metric('worker_busy_seconds_total') };
     const t0 = Date.now();
     const code = await submitAll(server, files);
+    const wall = (Date.now() - t0) / 1000, workers = await metric('workers');
+    const ended = await metric('jobs_ended_total') - before.ended;
+    const busy = await metric('worker_busy_seconds_total') - before.busy;
+    if (Number.isFinite(ended) && Number.isFinite(busy)) {
+        writeFileSync(join(resultsDir, 'daemon.tsv'), `${wall}\t${ended}\t${busy}\t${workers}\n`, { flag: 'a' });
+        console.log(`bench/catalogue: ${ended} jobs ended in ${wall.toFixed(0)} s (${(ended / (wall / 3600)).toFixed(1)} an hour), ` +
+            `the ${workers} workers busy ${(100 * busy / (workers * wall)).toFixed(1)}% of the time (/metrics)`);
+    }
     console.log(`bench/catalogue: the client ended (exit ${code}) after ${((Date.now() - t0) / 1000).toFixed(0)} s`);
     if (daemon) {
         const metrics = await fetch(`${server}/metrics`).then((r) => r.text()).catch(() => '');

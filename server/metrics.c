@@ -52,6 +52,11 @@ result tk_get_metrics(tk_api *a, conn *c, const call *k)
         {"workers", "gauge", "Worker threads.", (double)s.workers},
         {"workers_busy", "gauge", "Workers running a job.", (double)s.running},
         {"steps_total", "counter", "Flow steps taken since start.", (double)s.steps_total},
+        {"jobs_ended_total", "counter", "Jobs run here to done, failed or cancelled since start.",
+         (double)s.jobs_ended},
+        {"worker_busy_seconds_total", "counter",
+         "Seconds the workers spent running jobs since start (over workers x seconds: "
+         "utilisation).", s.busy_seconds},
         {"steps_per_second", "gauge", "Steps per second over the running jobs.",
          s.steps_per_second},
         {"http_body_bytes_held", "gauge",

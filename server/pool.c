@@ -269,5 +269,7 @@ void tk_pool_stats_get(tk_pool *p, tk_pool_stats *out)
     }
     pthread_mutex_unlock(&p->lock);
     out->steps_total = atomic_load(&p->steps_total);
+    out->jobs_ended = atomic_load(&p->jobs_ended);
+    out->busy_seconds = 1e-6 * (double)atomic_load(&p->busy_us);
 }
 

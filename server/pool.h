@@ -83,6 +83,8 @@ int tk_pool_cancel(tk_pool *p, int64_t id, json_t **doc, tk_error *err);
 typedef struct tk_pool_stats {
     size_t workers, running, queue_limit;
     unsigned long long steps_total; /* steps taken since start */
+    unsigned long long jobs_ended;  /* jobs run here to an end since start */
+    double busy_seconds;            /* the workers' time running jobs since start */
     double steps_per_second;        /* over the running jobs */
 } tk_pool_stats;
 void tk_pool_stats_get(tk_pool *p, tk_pool_stats *out);

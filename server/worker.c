@@ -336,6 +336,7 @@ void tk_worker_run(slot *sl, int64_t id)
     if (tk_store_get(p->store, id, &doc, &err))
         return; /* unreadable: it stays as stored, and health says why */
     job_run jr = {.slot = sl, .pool = p, .frame_after = -1, .last_step = -1};
+    double busy_from = tk_clock_seconds();
     pthread_mutex_lock(&p->lock);
     *sl = (slot){.pool = p, .id = id, .doc = doc, .opts = &jr.opts};
     pthread_mutex_unlock(&p->lock);
@@ -387,6 +388,8 @@ void tk_worker_run(slot *sl, int64_t id)
     sl->id = 0;
     sl->doc = NULL;
     pthread_mutex_unlock(&p->lock);
+    atomic_fetch_add(&p->busy_us, (unsigned long long)(1e6 * (tk_clock_seconds() - busy_from)));
+    atomic_fetch_add(&p->jobs_ended, TK_JOB_FINAL(state) && stored == TK_OK);
     say(p, id, "%s at step %ld", stored == TK_OK          ? tk_job_states[state]
                                  : stored == TK_ENOTFOUND ? "taken up elsewhere: let go"
                                                           : "let go unstored (the store fails)",

@@ -36,6 +36,8 @@ struct tk_pool {
     pthread_t *threads;   /* threads[i] runs slots[i]; only tk_pool_start writes them */
     size_t nslots, ready;
     atomic_ullong steps_total;
+    atomic_ullong busy_us;    /* microseconds the workers have run jobs */
+    atomic_ullong jobs_ended; /* jobs run here to done, failed or cancelled */
 };
 
 /* The slot's job as it stands: its document with the latest figures

@@ -349,4 +349,23 @@ describe('unknown paths and wrong methods', () => {
         const n = Number(/^tightknot_http_responses_total\{code="4xx"\} (\d+)$/m.exec(m.text)[1]);
         assert.ok(n >= MALFORMED.length * 2 + BINARY.length, `4xx count ${n}`);
     });
+
+    test('metrics count the jobs ended and the workers\' busy time', async () => {
+        const figures = async () => {
+            const text = (await d.get('/metrics')).text;
+            const get = (name) => Number(new RegExp(`^tightknot_${name} (\\S+)$`, 'm').exec(text)[1]);
+            return { ended: get('jobs_ended_total'), busy: get('worker_busy_seconds_total') };
+        };
+        const before = await figures();
+        const t0 = performance.now();
+        const job = await waitFinal(d, (await submit(d, { catalogue: '3.1', options: { resolution: 5, steps: 300 } })).id);
+        const wall = (performance.now() - t0) / 1000;
+        assert.equal(job.state, 'done');
+        const now = await figures();
+        assert.equal(now.ended, before.ended + 1);
+        // the one worker ran this job for at least its own seconds, and for
+        // no longer than the wall time between the two scrapes
+        assert.ok(now.busy - before.busy >= job.seconds, `${now.busy - before.busy} s busy, the job ${job.seconds} s`);
+        assert.ok(now.busy - before.busy <= wall, `${now.busy - before.busy} s busy in ${wall} s`);
+    });
 });
