@@ -424,10 +424,13 @@ int tk_schedule_resume(tk_run *r, const tk_curve *curve, const tk_resume *at, tk
     r->schedule.final_ropelength = at->final_ropelength;
     r->schedule.coarse_levels = coarse_levels(r);
     /* late levels (coarsen_late) are reckoned from a ropelength the place
-     * does not keep: the level it is at is the most it can have had */
-    if (r->opt.vertices > 0 && !(at->final_ropelength > 0.0) &&
-        at->coarse_level > r->schedule.coarse_levels && at->coarse_level <= MAX_COARSE_LEVELS)
-        r->schedule.coarse_levels = at->coarse_level;
+     * does not keep, so it keeps their count (a place from before it did
+     * not: the level it is at is the most it can have had) */
+    if (r->opt.vertices > 0 && !(at->final_ropelength > 0.0)) {
+        int late = at->coarse_levels > 0 ? at->coarse_levels : at->coarse_level - at->loose;
+        if (late > r->schedule.coarse_levels && late <= MAX_COARSE_LEVELS)
+            r->schedule.coarse_levels = late;
+    }
     r->schedule.restarts = at->restarts;
     r->schedule.loose = at->loose;
     if (at->loose > loose_levels(r) ||
@@ -456,6 +459,7 @@ void tk_schedule_resume_point(const tk_run *r, tk_resume *out)
 {
     out->start_ropelength = r->schedule.start_ropelength;
     out->coarse_level = r->schedule.coarse_level;
+    out->coarse_levels = r->schedule.coarse_levels;
     out->loose = r->schedule.loose;
     out->polish_level = r->schedule.polish_level;
     out->share_from = r->schedule.share_from;
@@ -732,7 +736,11 @@ static void keep_at_tube(tk_run *r)
  * vertices spent the first 120 s of its 600 coming down to 57.10 on 480
  * vertices, and its explored tries (escape.c) began after that; with them
  * it was on 240 vertices after 3.7 s, at 57.15 after 25 s, and its tries
- * had explored that level and reached 56.80 by 57 s. */
+ * had explored that level and reached 56.80 by 57 s.  The loose levels
+ * come with them, as at a start: the parametric figure-eight at 280
+ * vertices (15,000 steps) otherwise stopped in its kinked trap on 140
+ * (55.29), and its turned tries, which keep its symmetry, left it only
+ * for 54.51; with them it came to 42.1085 before any try. */
 static int coarsen_late(tk_run *r, double rope, tk_error *err)
 {
     const tk_options *o = &r->opt;
@@ -743,7 +751,9 @@ static int coarsen_late(tk_run *r, double rope, tk_error *err)
     int levels = levels_below(r, (double)o->vertices / rope);
     if (levels == 0)
         return TK_OK;
-    r->schedule.coarse_level = r->schedule.coarse_levels = levels;
+    r->schedule.coarse_levels = levels;
+    r->schedule.loose = loose_levels(r);
+    r->schedule.coarse_level = levels + r->schedule.loose;
     r->schedule.share_from = tk_schedule_spent(r);
     return resample_to(r, level_count(r, rope), err);
 }

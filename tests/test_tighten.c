@@ -1717,43 +1717,62 @@ END_TEST
 /* With the vertices option a start too loose for a coarse level gets one
  * once its ropelength allows it (schedule.c, coarsen_late): half the
  * vertices at the first step whose ropelength before it is at most
- * vertices / (2 x 2.5), not before; a run resumed on that level goes on
- * there, and ends on the final polygon. */
+ * vertices / (2 x 2.5), not before, with the loose levels below it; a
+ * run resumed on that level goes on there, and ends on the final
+ * polygon. */
 START_TEST(a_loose_start_gets_its_coarse_level_late)
 {
     tk_curve *c = NULL;
     ck_assert_int_eq(tk_generate_torus(2, 3, 0, &c, NULL), TK_OK);
-    tk_options o = TK_OPTIONS_INIT;
-    o.autoscale = true;
-    o.vertices = 180;
-    o.max_steps = 600;
-    o.escapes = 0;
-    tk_run *run = NULL;
-    tk_error err;
-    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
-    const double allows = 180.0 / (2.0 * 2.5);
-    ck_assert_uint_eq(tk_run_curve(run)->nvert, 180);
-    ck_assert(tk_run_latest(run)->ropelength > allows);
-    double rope = 0.0;
-    while (tk_run_curve(run)->nvert == 180 && tk_run_latest(run)->step < 300) {
-        rope = tk_run_latest(run)->ropelength;
-        ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
-        if (tk_run_curve(run)->nvert == 180)
-            ck_assert_msg(rope > allows, "step %ld: ropelength %.6g allows 90 vertices",
-                          tk_run_latest(run)->step, rope);
+    /* without loose levels, and with the default's (one: 180 vertices a
+     * round torus of ropelength 38 are 4.7 a unit, 2.4 at the coarse
+     * level, 1.2 a halving further) */
+    for (int loose = 0; loose <= 1; loose++) {
+        tk_options o = TK_OPTIONS_INIT;
+        o.autoscale = true;
+        o.vertices = 180;
+        o.max_steps = 600;
+        o.escapes = 0;
+        if (!loose)
+            o.loose = 0;
+        tk_run *run = NULL;
+        tk_error err;
+        ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+        const double allows = 180.0 / (2.0 * 2.5);
+        ck_assert_uint_eq(tk_run_curve(run)->nvert, 180);
+        ck_assert(tk_run_latest(run)->ropelength > allows);
+        double rope = 0.0;
+        while (tk_run_curve(run)->nvert == 180 && tk_run_latest(run)->step < 300) {
+            rope = tk_run_latest(run)->ropelength;
+            ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
+            if (tk_run_curve(run)->nvert == 180)
+                ck_assert_msg(rope > allows, "step %ld: ropelength %.6g allows 90 vertices",
+                              tk_run_latest(run)->step, rope);
+        }
+        long at_step = tk_run_latest(run)->step;
+        size_t count = (size_t)ceil(ldexp(180.0, -(1 + loose)));
+        printf("coarse level from step %ld, at ropelength %.6g, on %zu vertices\n", at_step, rope,
+               tk_run_curve(run)->nvert);
+        ck_assert_uint_eq(tk_run_curve(run)->nvert, count);
+        ck_assert(rope <= allows);
+        /* resumed there, it keeps its levels, late and loose, and ends on
+         * the final polygon through each */
+        tk_resume at;
+        run = interrupted(run, at_step + 5, &at);
+        ck_assert_int_eq(at.coarse_level, 1 + loose);
+        ck_assert_int_eq(at.coarse_levels, 1);
+        ck_assert_int_eq(at.loose, loose);
+        ck_assert_uint_eq(tk_run_curve(run)->nvert, count);
+        size_t nh = 0, rises = 0;
+        ck_assert_int_eq(tk_run_until(run, NULL, &err), TK_OK);
+        const tk_step_report *h = tk_run_history(run, &nh);
+        for (size_t i = 1; i < nh; i++)
+            rises += h[i].vertices > h[i - 1].vertices;
+        ck_assert_uint_eq(rises, (size_t)(1 + loose));
+        ck_assert_int_eq(tk_run_latest(run)->step, 600);
+        ck_assert_uint_eq(tk_run_latest(run)->vertices, 180);
+        tk_run_free(&run);
     }
-    long at_step = tk_run_latest(run)->step;
-    printf("coarse level from step %ld, at ropelength %.6g\n", at_step, rope);
-    ck_assert_uint_eq(tk_run_curve(run)->nvert, 90);
-    ck_assert(rope <= allows);
-    tk_resume at;
-    run = interrupted(run, at_step + 5, &at);
-    ck_assert_int_eq(at.coarse_level, 1);
-    ck_assert_uint_eq(tk_run_curve(run)->nvert, 90);
-    ck_assert_int_eq(tk_run_until(run, NULL, &err), TK_OK);
-    ck_assert_int_eq(tk_run_latest(run)->step, 600);
-    ck_assert_uint_eq(tk_run_latest(run)->vertices, 180);
-    tk_run_free(&run);
     tk_curve_free(&c);
 }
 END_TEST

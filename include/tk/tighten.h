@@ -355,6 +355,8 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out);
       "the ropelength of the input, before any resampling")                                  \
     X(coarse_level, INT, 0, 0, 64, "coarse_level", "halvings of the vertex count still to "  \
       "undo")                                                                                \
+    X(coarse_levels, INT, 0, 0, 64, "coarse_levels", "coarse levels below the final "         \
+      "polygon, late ones included (0: as the options reckon them)")                         \
     X(loose, INT, 0, 0, 2, "loose", "loose levels of the current schedule")                  \
     X(polish_level, INT, 0, 0, 1000, "polish_level", "times the ropelength has all but "     \
       "stopped falling on this polygon")                                                     \
