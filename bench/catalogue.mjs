@@ -101,7 +101,7 @@ const settingsText = (loose, engine) => `resolution ${opt.resolution}, ${opt.sec
     + `a start, autoscale, default escapes${loose ? `, loose ${loose}` : ''}${engine ? `, engine ${engine}` : ''}`;
 if (opt.engine === null) {
     const git = spawnSync('git', ['log', '-1', '--format=%h', '--', 'engine', 'include/tk'],
-        { encoding: 'utf8', cwd: dirname(fileURLToPath(import.meta.url)) });
+        { encoding: 'utf8', cwd: resolve(dirname(fileURLToPath(import.meta.url)), '..') });
     opt.engine = git.status === 0 ? git.stdout.trim() : '';
 }
 const SETTINGS = settingsText(opt.loose, opt.engine);
