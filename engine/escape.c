@@ -318,9 +318,6 @@ static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far,
  * first) ended at 91.64, still falling, with its turned try started on
  * the coarsest level, and at 89.25 with it started on the loose levels. */
 enum { TRY_TURNED, TRY_FAR, TRY_NEAR, TRY_KINDS };
-#ifdef EXPLORE_NEAR_FIRST
-static const int explored_order[TRY_KINDS] = {TRY_NEAR, TRY_TURNED, TRY_FAR};
-#endif
 
 /* The turned curve is relaxed on TURN_RESOLUTION vertices a unit of
  * ropelength, for TURN_STEPS steps (about 2 s for 10.124's 107). */
@@ -338,18 +335,9 @@ static const int explored_order[TRY_KINDS] = {TRY_NEAR, TRY_TURNED, TRY_FAR};
  * about the centroid at 71.00266 and 71.00279 (each through a turned try
  * on the final polygon, from 71.058). */
 static int try_curve(tk_run *r, const tk_curve *best, double thickness, double rope, int index,
-                     bool explored, tk_curve **out, double *amplitude, bool *turned, bool *loose,
-                     tk_error *err)
+                     tk_curve **out, double *amplitude, bool *turned, bool *loose, tk_error *err)
 {
     int kind = index % TRY_KINDS;
-#ifdef EXPLORE_NEAR_FIRST
-    if (explored)
-        kind = explored_order[kind];
-    bool first_turn = kind == TRY_TURNED && index < TRY_KINDS;
-#else
-    (void)explored;
-    bool first_turn = index == TRY_TURNED;
-#endif
     *turned = false;
     /* turned inside out, a pinned vertex would leave its constraint far
      * behind: a far deformation instead */
@@ -360,7 +348,7 @@ static int try_curve(tk_run *r, const tk_curve *best, double thickness, double r
         return deformed(r, best, thickness, kind == TRY_FAR, out, amplitude, err);
     double offset[3];
     tk_relax_turn_offset(&r->escape.rng, offset);
-    if (first_turn) /* the first turn of the kind of tries: about the centroid */
+    if (index == TRY_TURNED) /* the first turn of the kind of tries: about the centroid */
         offset[0] = offset[1] = offset[2] = 0.0;
     size_t count = (size_t)(TURN_RESOLUTION * rope);
     if (count < 8 * best->ncomp)
@@ -373,9 +361,7 @@ static int try_curve(tk_run *r, const tk_curve *best, double thickness, double r
     /* a centre too near the curve, or too few vertices to turn it: a far
      * deformation instead */
     *turned = rc == TK_OK;
-    if (rc)
-        return deformed(r, best, thickness, true, out, amplitude, err);
-    return TK_OK;
+    return rc ? deformed(r, best, thickness, true, out, amplitude, err) : TK_OK;
 }
 
 /* Exploration: before the run first refines its coarsest polygon, tries
@@ -500,7 +486,7 @@ static int explore_next(tk_run *r, tk_error *err)
     bool turned = false;
     bool loose = false;
     rc = try_curve(r, r->escape.explored, r->escape.explored_thickness, r->escape.explored_rope,
-                   r->escape.explore_tries, true, &curve, &amplitude, &turned, &loose, err);
+                   r->escape.explore_tries, &curve, &amplitude, &turned, &loose, err);
     tk_escape *e = rc ? NULL : log_entry(r, err);
     if (!e) {
         tk_curve_free(&curve);
@@ -595,8 +581,8 @@ int tk_escape_before_step(tk_run *r, tk_error *err)
     int fine = tk_escape_tries(r) - r->escape.explore_tries;
     bool turned = false, loose = false;
     int rc = try_curve(r, r->escape.best, r->escape.best_report.thickness,
-                       r->escape.best_report.ropelength, fine, false, &curve, &amplitude, &turned,
-                       &loose, err);
+                       r->escape.best_report.ropelength, fine, &curve, &amplitude, &turned, &loose,
+                       err);
     tk_escape *e = rc ? NULL : log_entry(r, err);
     if (!e) {
         tk_curve_free(&curve);

@@ -467,14 +467,17 @@ void tk_schedule_resume_point(const tk_run *r, tk_resume *out);
 int tk_schedule_fit(tk_run *r, tk_error *err);
 /* The run's curve replaced by `curve` (taken over): with `coarse` the
  * schedule starts again from its coarsest level (the curve resampled to
- * it), else `curve` is on the final polygon (the escapes' best): it keeps
- * its vertices, the schedule is at the final level and the polishing
- * level is `polish`; made feasible by scaling, type-checked. */
+ * it), or with `loose` too from the loose levels below it where the run
+ * has them and the resampled curve keeps its type; else `curve` is on the
+ * final polygon (the escapes' best): it keeps its vertices, the schedule
+ * is at the final level and the polishing level is `polish`; made
+ * feasible by scaling, type-checked. */
 int tk_schedule_restart(tk_run *r, tk_curve *curve, bool coarse, bool loose, int polish,
                         tk_error *err);
 /* The same on the coarsest level before the final polygon is fixed (the
  * escapes' exploration): `curve` resampled to that level's vertices at
- * ropelength `rope`, or kept as it is with 0. */
+ * ropelength `rope`, or kept as it is with 0; with `loose`, on the loose
+ * levels as tk_schedule_restart puts it. */
 int tk_schedule_explore(tk_run *r, tk_curve *curve, double rope, bool loose, tk_error *err);
 /* The vertices of the coarsest level at ropelength `rope`. */
 size_t tk_schedule_coarsest_count(tk_run *r, double rope);
