@@ -256,7 +256,6 @@ static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far,
 {
     size_t ncoef = best->ncomp * ESCAPE_MODES * 6;
     double *coef = malloc(ncoef * sizeof *coef);
-    tk_invariants type = TK_INVARIANTS_INIT;
     int rc = coef ? tk_curve_copy(best, out, err)
                   : tk_error_set(err, TK_ENOMEM, "out of memory for a deformation");
     for (size_t i = 0; !rc && i < ncoef; i++)
@@ -272,13 +271,8 @@ static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far,
         if (tk_thickness_measure(*out, NULL, &m, &why) != TK_OK ||
             !(m.thickness >= keep * thickness))
             continue;
-        double t0 = tk_clock();
-        int type_rc = tk_invariants_compute(*out, &type, &why);
-        if (!type_rc)
-            type_rc = tk_invariants_compare(&r->type.start, &type, &why);
-        r->escape.type_seconds += tk_clock() - t0;
-        found = type_rc == TK_OK;
-        if (found) {
+        rc = tk_type_kept(r, *out, &found, err);
+        if (!rc && found) {
             bool embedded;
             rc = tk_struts_path_embedded(best, *out, &embedded, err);
             found = !rc && embedded;
@@ -286,7 +280,6 @@ static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far,
         *amplitude = a / r->tau;
     }
     free(coef);
-    tk_invariants_free(&type);
     if (!rc && !found) {
         /* nothing that small changes it: tighten the best again as it is */
         memcpy((*out)->xyz, best->xyz, 3 * best->nvert * sizeof *best->xyz);

@@ -233,7 +233,6 @@ struct tk_run {
         tk_escape *log;      /* one per try */
         size_t nlog, log_capacity;
         int improved;
-        double type_seconds; /* the deformations' types checked */
         int most;            /* escapes option, or 0 for a curve with an open component */
     } escape;
 
@@ -351,6 +350,9 @@ int tk_type_start(tk_run *r, const tk_curve *start, const tk_invariants *known, 
 /* The run's curve still has the start's knot or link type; else TK_ETYPE
  * with a message that begins with `when` ("resampling to 400 vertices"). */
 int tk_type_check(tk_run *r, const char *when, tk_error *err);
+/* Whether `c` (a curve the run may take: a deformation, a resampled try)
+ * has the start's type, into *kept; TK_ENOMEM only. */
+int tk_type_kept(tk_run *r, const tk_curve *c, bool *kept, tk_error *err);
 void tk_type_free(tk_run *r);
 
 /* ---- active.c ---- */

@@ -89,8 +89,9 @@
  * 90.9, and catalogue 10.124 to 71.055 from 71.128.  Edges are then up
  * to 0.8 diameters long, and resampling keeps the type (none of the
  * catalogue's 398 files nor 50 tightened curves changed type resampled
- * at 0.3 a unit).  Tries are still judged, and escapes start, on the
- * coarsest level (tk_escape_judged_here): with the loose levels as the
+ * at 0.3 a unit).  Tries are still judged on the coarsest level
+ * (tk_escape_judged_here), and near ones start there (turned and far
+ * ones start on the loose levels, go_loose): with the loose levels as the
  * coarsest, tries were ranked on polygons of 37 vertices for 8_19, and
  * catalogue 8.19 ended in the basin 0.06% above the one it had reached
  * (61.06702 against 61.02827, bench/starts, 60 s). */
@@ -625,21 +626,12 @@ static int go_loose(tk_run *r, const tk_curve *curve, double rope, size_t *count
     r->schedule.coarse_level = r->schedule.coarse_levels + loose;
     size_t want = level_count(r, fmax(rope, reckoned_ropelength(&m)));
     tk_curve *resampled = NULL;
-    tk_invariants type = TK_INVARIANTS_INIT;
-    tk_error why;
+    bool kept = false;
     rc = tk_curve_resample_total(curve, want, &resampled, err);
-    if (rc)
-        return rc;
-    double t0 = tk_clock();
-    int type_rc = tk_invariants_compute(resampled, &type, &why);
-    if (type_rc == TK_ENOMEM)
-        rc = tk_error_set(err, type_rc, "%s", why.message);
-    else if (!type_rc)
-        type_rc = tk_invariants_compare(&r->type.start, &type, &why);
-    r->type.seconds += tk_clock() - t0;
-    tk_invariants_free(&type);
+    if (!rc)
+        rc = tk_type_kept(r, resampled, &kept, err);
     tk_curve_free(&resampled);
-    if (!rc && !type_rc) {
+    if (!rc && kept) {
         r->schedule.loose = loose;
         *count = want;
     } else {

@@ -442,7 +442,7 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out)
         .nnls_solves = r->motion.nnls_solves,
         .nnls_iterations = r->motion.nnls_iterations,
         .factorisations = r->motion.factorisations,
-        .invariants = r->type.seconds + r->escape.type_seconds,
+        .invariants = r->type.seconds,
         .undone_steps = r->recovery.undone,
         .rescales = r->recovery.rescales,
         .bent_corrections = r->recovery.bent,

@@ -36,6 +36,18 @@ int tk_type_check(tk_run *r, const char *when, tk_error *err)
     return TK_OK;
 }
 
+int tk_type_kept(tk_run *r, const tk_curve *c, bool *kept, tk_error *err)
+{
+    tk_invariants type = TK_INVARIANTS_INIT;
+    tk_error why;
+    double t0 = tk_clock();
+    int rc = tk_invariants_compute(c, &type, &why);
+    *kept = rc == TK_OK && tk_invariants_compare(&r->type.start, &type, NULL) == TK_OK;
+    r->type.seconds += tk_clock() - t0;
+    tk_invariants_free(&type);
+    return rc == TK_ENOMEM ? tk_error_set(err, rc, "%s", why.message) : TK_OK;
+}
+
 void tk_type_free(tk_run *r)
 {
     tk_invariants_free(&r->type.start);
