@@ -550,26 +550,17 @@ int tk_curve_resample(const tk_curve *src, const size_t *counts, tk_curve **out,
     return rc;
 }
 
-int tk_curve_resample_total(const tk_curve *src, size_t total, tk_curve **out,
-                            tk_error *err)
+int tk_curve_share_total(const tk_curve *src, size_t total, size_t *counts, tk_error *err)
 {
-    *out = NULL;
-    int vrc = tk_curve_validate(src, err);
-    if (vrc)
-        return vrc;
     size_t minimum = 0;
     for (size_t i = 0; i < src->ncomp; i++)
         minimum += src->closed[i] ? 3 : 2;
     if (total < minimum)
         return tk_error_set(err, TK_EINVAL, "%zu vertices are too few for %zu components",
                             total, src->ncomp);
-    size_t *counts = calloc(src->ncomp, sizeof *counts);
     double *share = calloc(src->ncomp, sizeof *share);
-    if (!counts || !share) {
-        free(counts);
-        free(share);
+    if (!share)
         return tk_error_set(err, TK_ENOMEM, "out of memory");
-    }
     double length = tk_curve_length(src);
     size_t given = 0;
     for (size_t i = 0; i < src->ncomp; i++) {
@@ -605,9 +596,24 @@ int tk_curve_resample_total(const tk_curve *src, size_t total, tk_curve **out,
         counts[best]--;
         given--;
     }
-    int rc = tk_curve_resample(src, counts, out, err);
-    free(counts);
     free(share);
+    return TK_OK;
+}
+
+int tk_curve_resample_total(const tk_curve *src, size_t total, tk_curve **out,
+                            tk_error *err)
+{
+    *out = NULL;
+    int rc = tk_curve_validate(src, err);
+    if (rc)
+        return rc;
+    size_t *counts = calloc(src->ncomp, sizeof *counts);
+    if (!counts)
+        return tk_error_set(err, TK_ENOMEM, "out of memory");
+    rc = tk_curve_share_total(src, total, counts, err);
+    if (!rc)
+        rc = tk_curve_resample(src, counts, out, err);
+    free(counts);
     return rc;
 }
 

@@ -189,6 +189,64 @@ void tk_segment_closest(const double a0[3], const double a1[3],
     out->dist = dist3(out->p, out->q);
 }
 
+/* Whether x, a point of the plane of abc (n its normal, of either length),
+ * lies in the closed triangle: on the inner side of each of its edges. */
+static bool in_triangle(const double *const v[3], const double n[3], const double x[3])
+{
+    for (int k = 0; k < 3; k++) {
+        double e[3], d[3], w[3];
+        tk_sub3(v[(k + 1) % 3], v[k], e);
+        tk_sub3(x, v[k], d);
+        tk_cross3(e, d, w);
+        if (tk_dot3(w, n) < 0.0)
+            return false;
+    }
+    return true;
+}
+
+/* The closed triangle is its three edges and the points of its plane
+ * inside them: pq meets it within tol when it comes that near an edge,
+ * when an end of it lies within tol of the plane over the triangle (a
+ * segment in the plane across the triangle crosses an edge or has an end
+ * inside), or when it crosses the plane inside. */
+bool tk_segment_meets_triangle(const double a[3], const double b[3], const double c[3],
+                               const double p[3], const double q[3], double tol)
+{
+    const double *const v[3] = {a, b, c};
+    for (int k = 0; k < 3; k++) {
+        tk_closest cl;
+        tk_segment_closest(v[k], v[(k + 1) % 3], p, q, &cl);
+        if (cl.dist <= tol)
+            return true;
+    }
+    double e1[3], e2[3], n[3];
+    tk_sub3(b, a, e1);
+    tk_sub3(c, a, e2);
+    tk_cross3(e1, e2, n);
+    double norm = sqrt(tk_dot3(n, n));
+    if (!(norm > 0.0))
+        return false; /* a, b, c on a line: the edges above are all of it */
+    for (int k = 0; k < 3; k++)
+        n[k] /= norm;
+    const double *const ends[2] = {p, q};
+    double h[2];
+    for (int k = 0; k < 2; k++) {
+        double d[3];
+        tk_sub3(ends[k], a, d);
+        h[k] = tk_dot3(d, n);
+        double x[3] = {ends[k][0] - h[k] * n[0], ends[k][1] - h[k] * n[1],
+                       ends[k][2] - h[k] * n[2]};
+        if (fabs(h[k]) <= tol && in_triangle(v, n, x))
+            return true;
+    }
+    if (!(h[0] * h[1] < 0.0))
+        return false;
+    double s = h[0] / (h[0] - h[1]);
+    double x[3] = {p[0] + s * (q[0] - p[0]), p[1] + s * (q[1] - p[1]), p[2] + s * (q[2] - p[2])};
+    return in_triangle(v, n, x);
+}
+
+
 /* Equation (7): by Clarke's theorem for min-functions, the derivative of
  * the distance is that of |p(s0) - q(t0)| at the fixed minimising
  * parameters. */

@@ -9,6 +9,7 @@
 #include "rng.h"
 #include "tk/generate.h"
 #include "tk/invariants.h"
+#include "tk/isotopy.h"
 
 /* The springs' weight against the repulsion: at 1 the repulsion pulls
  * edges out to twice the mean (catalogue 10.124 relaxed: edges 1.09 to
@@ -22,8 +23,8 @@
 #define RELAX_STOP 1e-9
 #define RELAX_GROW 1.5
 #define RELAX_MOVE 0.25
-/* Turning inside out: the curve is first resampled to at least TURN_FINE
- * vertices (32 for each of the result's), and the centre must be at
+/* Turning inside out: the curve is first cut to about TURN_FINE vertices
+ * along its edges, or 32 for each of the result's if more, and the centre must be at
  * least TURN_CLEARANCE of the curve's spread from it; the result's count
  * doubles up to TURN_DOUBLINGS - 1 times until its type is the curve's. */
 #define TURN_FINE 1000
@@ -238,7 +239,7 @@ int tk_relax_turn(const tk_curve *c, const double offset[3], size_t vertices, in
     size_t fine = TURN_FINE > 32 * vertices ? TURN_FINE : 32 * vertices;
     tk_curve *x = NULL, *coarse = NULL;
     tk_invariants type = TK_INVARIANTS_INIT, now = TK_INVARIANTS_INIT;
-    rc = tk_curve_resample_total(c, fine, &x, err);
+    rc = tk_isotopy_refine(c, fine, &x, err);
     double centre[3], spread = 0.0, length = tk_curve_length(c);
     if (!rc) {
         wire_centroid(x, centre);
@@ -278,17 +279,19 @@ int tk_relax_turn(const tk_curve *c, const double offset[3], size_t vertices, in
         rc = tk_invariants_compute(c, &type, err);
     }
     /* the inverted curve is uneven (what was near the centre is now far
-     * out and long): on too few vertices its polygon can pass through
-     * itself, so the count doubles until the type is kept */
+     * out and long): on too few vertices its polygon would pass through
+     * itself, and the invariants cannot see every such change (9.2.3,
+     * tk/isotopy.h), so it loses its vertices by triangle moves, and
+     * their count doubles until every move is clear; the invariants are
+     * checked too, for the fine polygon's chords standing for arcs */
     bool kept = false;
     for (int tries = 0; !rc && !kept && tries < TURN_DOUBLINGS; tries++, vertices *= 2) {
         tk_curve_free(&coarse);
-        tk_curve_free(out);
         tk_invariants_free(&now);
-        rc = tk_curve_resample_total(x, vertices, &coarse, err);
-        if (!rc)
+        rc = tk_isotopy_coarsen(x, vertices, &coarse, &kept, err);
+        if (!rc && kept)
             rc = tk_invariants_compute(coarse, &now, err);
-        kept = !rc && tk_invariants_compare(&type, &now, NULL) == TK_OK;
+        kept = !rc && kept && tk_invariants_compare(&type, &now, NULL) == TK_OK;
     }
     if (!rc && kept)
         rc = tk_relax(coarse, NULL, 0.0, steps, out, NULL, err);

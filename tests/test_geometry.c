@@ -2,6 +2,7 @@
  * 7 and 14) against central finite differences, exact minrad values. */
 #include <check.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -187,6 +188,102 @@ START_TEST(long_nearly_parallel_edges_far_out)
     ck_assert_double_eq_tol(c.t, 0.009908839195989845, 1e-9);
     tk_segment_closest(v3, v0, v1, v2, &c);
     ck_assert_double_eq_tol(c.dist, 0.9912776249001626, 1e-9);
+}
+END_TEST
+
+/* Segment against triangle, against a brute force: the least distance
+ * between N points along the segment and the triangle's points of a
+ * barycentric grid of step 1/N, which is within the grid's spacing
+ * (h = (|pq| + the triangle's longest side) / N) of the true distance.
+ * A segment said to meet the triangle must come within h of it on the
+ * grid; one said to miss it must not come within h of it (the true
+ * distance is then above 0).  Cases: random segments and triangles, and
+ * segments through a random point of the triangle's plane (inside or out)
+ * and segments in the plane, where the hard cases lie. */
+static double brute_triangle(const double *a, const double *b, const double *c,
+                             const double *p, const double *q, int n)
+{
+    double best = INFINITY;
+    for (int i = 0; i <= n; i++) {
+        double x[3];
+        for (int k = 0; k < 3; k++)
+            x[k] = p[k] + (q[k] - p[k]) * i / n;
+        for (int u = 0; u <= n; u++)
+            for (int v = 0; u + v <= n; v++) {
+                double d = 0.0;
+                for (int k = 0; k < 3; k++) {
+                    double y = a[k] + (b[k] - a[k]) * u / n + (c[k] - a[k]) * v / n;
+                    d += (x[k] - y) * (x[k] - y);
+                }
+                best = fmin(best, d);
+            }
+    }
+    return sqrt(best);
+}
+
+START_TEST(segment_meets_triangle_against_sampling)
+{
+    tkt_rng rng = {12345};
+    const int n = 60;
+    int met = 0, missed = 0, unclear = 0;
+    for (int t = 0; t < 600; t++) {
+        double a[3], b[3], c[3], p[3], q[3];
+        tkt_rng_point(&rng, 1.0, a);
+        tkt_rng_point(&rng, 1.0, b);
+        tkt_rng_point(&rng, 1.0, c);
+        int kind = t % 3;
+        if (kind == 0) {
+            tkt_rng_point(&rng, 1.0, p);
+            tkt_rng_point(&rng, 1.0, q);
+        } else {
+            /* through x = a + s (b - a) + u (c - a), s and u in -0.5 .. 1.5 */
+            double s = tkt_rng_range(&rng, -0.5, 1.5), u = tkt_rng_range(&rng, -0.5, 1.5);
+            double x[3], dir[3];
+            for (int k = 0; k < 3; k++)
+                x[k] = a[k] + s * (b[k] - a[k]) + u * (c[k] - a[k]);
+            tkt_rng_point(&rng, 1.0, dir);
+            if (kind == 2) { /* in the plane: dir along the triangle's sides */
+                double s2 = tkt_rng_range(&rng, -1.0, 1.0), u2 = tkt_rng_range(&rng, -1.0, 1.0);
+                for (int k = 0; k < 3; k++)
+                    dir[k] = s2 * (b[k] - a[k]) + u2 * (c[k] - a[k]);
+            }
+            double back = tkt_rng_range(&rng, 0.0, 1.0);
+            for (int k = 0; k < 3; k++) {
+                p[k] = x[k] - back * dir[k];
+                q[k] = x[k] + (1.0 - back) * dir[k];
+            }
+        }
+        double side = fmax(fmax(sqrt(pow(b[0] - a[0], 2) + pow(b[1] - a[1], 2) + pow(b[2] - a[2], 2)),
+                                sqrt(pow(c[0] - b[0], 2) + pow(c[1] - b[1], 2) + pow(c[2] - b[2], 2))),
+                           sqrt(pow(a[0] - c[0], 2) + pow(a[1] - c[1], 2) + pow(a[2] - c[2], 2)));
+        double len = sqrt(pow(q[0] - p[0], 2) + pow(q[1] - p[1], 2) + pow(q[2] - p[2], 2));
+        double h = (len + side) / n, brute = brute_triangle(a, b, c, p, q, n);
+        bool meets = tk_segment_meets_triangle(a, b, c, p, q, 0.0);
+        if (meets)
+            ck_assert_msg(brute <= h, "case %d: said to meet, but %g apart on the grid (h %g)",
+                          t, brute, h);
+        else
+            ck_assert_msg(brute > 0.0, "case %d: said to miss, but met on the grid", t);
+        if (brute > h)
+            ck_assert_msg(!meets, "case %d: %g apart, said to meet", t, brute);
+        met += meets;
+        missed += !meets && brute > h;
+        unclear += !meets && brute <= h;
+    }
+    printf("segment and triangle: %d met, %d missed, %d missed within the grid's spacing\n",
+           met, missed, unclear);
+    ck_assert_int_gt(met, 50);
+    ck_assert_int_gt(missed, 200);
+    /* a tolerance widens it: a segment parallel to the plane at height d */
+    double a[3] = {0, 0, 0}, b[3] = {1, 0, 0}, c[3] = {0, 1, 0};
+    double p[3] = {0.2, 0.2, 1e-3}, q[3] = {0.3, 0.1, 1e-3};
+    ck_assert(!tk_segment_meets_triangle(a, b, c, p, q, 0.5e-3));
+    ck_assert(tk_segment_meets_triangle(a, b, c, p, q, 2e-3));
+    /* a line of a triangle is its sides */
+    double d[3] = {2, 0, 0}, r[3] = {1.5, -1, 0}, s[3] = {1.5, 1, 0.5};
+    ck_assert(tk_segment_meets_triangle(a, b, d, r, s, 0.0) == false);
+    double s2[3] = {1.5, 1, 0};
+    ck_assert(tk_segment_meets_triangle(a, b, d, r, s2, 0.0));
 }
 END_TEST
 
@@ -382,6 +479,7 @@ int main(void)
     tcase_add_test(tc, segment_distance_exact_cases);
     tcase_add_test(tc, long_edge_keeps_its_closest_point);
     tcase_add_test(tc, long_nearly_parallel_edges_far_out);
+    tcase_add_test(tc, segment_meets_triangle_against_sampling);
     tcase_add_test(tc, distance_gradient_matches_finite_differences);
     tcase_add_test(tc, minrad_gradient_matches_finite_differences);
     tcase_add_test(tc, minrad_exact_values);

@@ -24,7 +24,7 @@ dir=$build/engine
 # type's checks) serve every room from just above the libraries.
 levels='
 0 pin error
-1 curve geometry struts nnls rigidity invariants record vect generate thickness relax
+1 curve geometry struts nnls rigidity invariants record vect generate thickness relax isotopy
 2 queries type
 3 active
 4 motion

@@ -123,6 +123,11 @@ int tk_curve_check_range(const tk_curve *c, tk_error *err);
 int tk_curve_resample(const tk_curve *src, const size_t *counts,
                       tk_curve **out, tk_error *err);
 
+/* `total` vertices shared among src's components in proportion to their
+ * lengths, into counts[ncomp] (each closed component gets at least 3,
+ * each open at least 2: TK_EINVAL when total is below that). */
+int tk_curve_share_total(const tk_curve *src, size_t total, size_t *counts, tk_error *err);
+
 /* As tk_curve_resample, with `total` vertices shared among components in
  * proportion to their lengths (each closed component gets at least 3, each
  * open at least 2). */

@@ -8,6 +8,7 @@
 #ifndef TK_GEOMETRY_H
 #define TK_GEOMETRY_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "tk/curve.h"
@@ -58,6 +59,15 @@ typedef struct tk_closest {
 void tk_segment_closest(const double a0[3], const double a1[3],
                         const double b0[3], const double b1[3],
                         tk_closest *out);
+
+/* Whether the segment pq comes within tol of the closed triangle abc
+ * (meets it when tol is 0): through its interior, touching an edge, or
+ * lying in its plane across it.  A degenerate triangle (a, b, c on a
+ * line) is the segments between them.  What a triangle move sweeps: the
+ * polygon a b c becomes a c through the triangle, and an edge that meets
+ * it is one a strand would pass through. */
+bool tk_segment_meets_triangle(const double a[3], const double b[3], const double c[3],
+                               const double p[3], const double q[3], double tol);
 
 /* Gradient of the edge-edge distance (equation 7) with respect to the four
  * end points (a0, a1, b0, b1), as 12 numbers, given their closest points.

@@ -67,12 +67,14 @@ int tk_relax(const tk_curve *c, const tk_curve *target, double pull, int iterati
  * start's that no small deformation reaches.  The centre is the curve's
  * centroid as a wire plus `offset` times its spread (the root mean
  * square distance of its points from the centroid).  Inversion and
- * mirror keep the type and its chirality on the smooth curve; the
- * polygon's is checked (Alexander polynomials and linking numbers), and
- * where too few vertices let it pass through itself their count doubles
- * (twice at most; the result can have 4 x `vertices`).  TK_ENUMERIC when
- * the centre lies within 1e-3 of the spread from the curve, or the type
- * changed all the same. */
+ * mirror keep the type and its chirality on the smooth curve.  The
+ * inverted polygon, on 32 x `vertices` (at least 1,000), comes down to
+ * `vertices` by triangle moves (tk_isotopy_coarsen), which keep its type
+ * exactly; where too few vertices would let it pass through itself their
+ * count doubles (twice at most; the result can have 4 x `vertices`), and
+ * the result's Alexander polynomials and linking numbers are checked
+ * too.  TK_ENUMERIC when the centre lies within 1e-3 of the spread from
+ * the curve, or the type could not be kept. */
 int tk_relax_turn(const tk_curve *c, const double offset[3], size_t vertices, int steps,
                   tk_curve **out, tk_error *err);
 
