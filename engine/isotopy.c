@@ -9,8 +9,8 @@
 
 #include "tk/geometry.h"
 
-/* An edge within ISOTOPY_MARGIN of the mean edge of a move's triangle
- * blocks it: the tests are then decided far above rounding. */
+/* An edge within ISOTOPY_MARGIN of the polygon's mean edge of a move's
+ * triangle blocks it: the tests are then decided far above rounding. */
 #define ISOTOPY_MARGIN 1e-9
 /* An edge from a corner of the triangle meets it only at that corner
  * unless it leaves the corner in the triangle's plane, within the angle
@@ -143,6 +143,18 @@ static bool clear_stretch(polygon *p, size_t from, size_t to, size_t id)
     return p->next[from] == to;
 }
 
+/* What both functions start with: no result yet, c valid, a count for
+ * each of its components. */
+static int begin(const tk_curve *c, tk_curve **out, size_t **counts, tk_error *err)
+{
+    *out = NULL;
+    int rc = tk_curve_validate(c, err);
+    if (rc)
+        return rc;
+    *counts = calloc(c->ncomp, sizeof **counts);
+    return *counts ? TK_OK : tk_error_set(err, TK_ENOMEM, "out of memory");
+}
+
 /* The vertices component comp keeps, m of them, into keep (local
  * indices, rising): vertex 0 (and an open component's last), and for the
  * k-th of the others the vertex past the (k-1)-th whose arclength is
@@ -175,14 +187,11 @@ static void choose(const tk_curve *c, size_t comp, size_t m, size_t *keep)
 int tk_isotopy_coarsen(const tk_curve *c, size_t total, tk_curve **out, bool *kept,
                        tk_error *err)
 {
-    *out = NULL;
     *kept = false;
-    int rc = tk_curve_validate(c, err);
+    size_t *counts = NULL;
+    int rc = begin(c, out, &counts, err);
     if (rc)
         return rc;
-    size_t *counts = calloc(c->ncomp, sizeof *counts);
-    if (!counts)
-        return tk_error_set(err, TK_ENOMEM, "out of memory");
     rc = tk_curve_share_total(c, total, counts, err);
     for (size_t comp = 0; !rc && comp < c->ncomp; comp++)
         if (counts[comp] > tk_curve_comp_vertices(c, comp))
@@ -271,13 +280,10 @@ static size_t pieces(const tk_curve *c, size_t comp, size_t i, size_t total, dou
 
 int tk_isotopy_refine(const tk_curve *c, size_t total, tk_curve **out, tk_error *err)
 {
-    *out = NULL;
-    int rc = tk_curve_validate(c, err);
+    size_t *counts = NULL;
+    int rc = begin(c, out, &counts, err);
     if (rc)
         return rc;
-    size_t *counts = calloc(c->ncomp, sizeof *counts);
-    if (!counts)
-        return tk_error_set(err, TK_ENOMEM, "out of memory");
     double length = tk_curve_length(c);
     for (size_t comp = 0; comp < c->ncomp; comp++) {
         counts[comp] = c->closed[comp] ? 0 : 1;
