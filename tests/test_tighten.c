@@ -1783,8 +1783,9 @@ END_TEST
  * reckoned from the same ropelength; a run resumed during an escape
  * keeps it too.  With the loose option the first tightening starts that
  * many halvings below the coarse level (0.625 and 1.25 a unit for 2) and
- * passes through them, and so do the turned and far tries; every try is
- * judged on the coarse level, and near ones start there.
+ * passes through them, and so do the explored turned and far tries;
+ * every try is judged on the coarse level, and near ones and those on
+ * the final polygon start there.
  * T(2,5) on the round torus at resolution 5: its start is half as long
  * again as the tight knot. */
 static void loose_start_escapes(int loose, long steps)
@@ -1831,9 +1832,10 @@ static void loose_start_escapes(int loose, long steps)
         int k = h[i].escapes - 1;
         /* the kinds take turns: turned, far, near; the first two are
          * loose tries, on the loose levels where the run has them, their
-         * count reckoned from at least the reference */
+         * count reckoned from at least the reference, when explored; on
+         * the final polygon every try starts on the coarse level */
         int kind = k < 0 ? -1 : (k - (e[k].explored ? 0 : (int)explored)) % 3;
-        bool loosened = loose && kind >= 0 && kind != 2;
+        bool loosened = loose && kind >= 0 && kind != 2 && e[k].explored;
         if (h[i].escapes > h[i - 1].escapes && e[k].explored) {
             /* explored: the lowest curve's polygon, the first plateau's
              * (turned: the coarse polygon of the lowest ropelength) */
