@@ -26,7 +26,8 @@
 /* Turning inside out: the curve is first cut to about TURN_FINE vertices
  * along its edges, or 32 for each of the result's if more, and the centre must be at
  * least TURN_CLEARANCE of the curve's spread from it; the result's count
- * doubles up to TURN_DOUBLINGS - 1 times until its type is the curve's. */
+ * doubles up to TURN_DOUBLINGS - 1 times until the triangle moves down
+ * to it are all clear and its type is the curve's. */
 #define TURN_FINE 1000
 #define TURN_CLEARANCE 1e-3
 #define TURN_OFFSET 0.15
@@ -296,8 +297,8 @@ int tk_relax_turn(const tk_curve *c, const double offset[3], size_t vertices, in
     if (!rc && kept)
         rc = tk_relax(coarse, NULL, 0.0, steps, out, NULL, err);
     if (!rc && !kept)
-        rc = tk_error_set(err, TK_ENUMERIC, "turned inside out on up to %zu vertices, the "
-                          "curve changed its type", vertices / 2);
+        rc = tk_error_set(err, TK_ENUMERIC, "turned inside out, the curve could not keep "
+                          "its type on up to %zu vertices", vertices / 2);
     if (rc)
         tk_curve_free(out);
     tk_invariants_free(&type);
