@@ -604,7 +604,14 @@ static int restart(tk_run *r, tk_curve *curve, size_t count, int polish, tk_erro
     r->schedule.polish_level = polish;
     r->schedule.polish_from = r->life.nhistory;
     r->schedule.resampled_from = r->life.nhistory;
-    r->schedule.resolved_at = r->life.latest.ropelength;
+    /* the coarse polygon follows this curve's ropelength down from its
+     * own (tk_schedule_before_step), not from the curve it replaces: a
+     * turned try of catalogue 10.34 (resolution 5), autoscaled far
+     * looser than the best curve it came from (89.14), stayed on its
+     * 164-vertex loose level for 10 s, still at 101.7, as its ropelength
+     * had to fall below three quarters of 89.14 first; following its own
+     * down (to 56 vertices in 2 s) the run ended at 88.28, not 88.84 */
+    r->schedule.resolved_at = m.ropelength;
     tk_stepping_reset(r);
     return resampled ? TK_OK : tk_type_check(r, "an escape's deformation", err);
 }
