@@ -791,6 +791,20 @@ int tk_schedule_before_step(tk_run *r, tk_error *err)
     if (!(rope < r->schedule.resolved_at * (1.0 - fraction)) ||
         !(want < (double)r->shared.curve->nvert * (1.0 - fraction)))
         return TK_OK;
+    /* so few vertices can lose the type (a wandered start of catalogue
+     * 9.45, on a loose try's level at 47 vertices, failed its job that
+     * way): where they would, the polygon stays, until the ropelength
+     * has fallen by as much again */
+    tk_curve *resampled = NULL;
+    bool kept = false;
+    rc = tk_curve_resample_total(r->shared.curve, (size_t)want, &resampled, err);
+    if (!rc)
+        rc = tk_type_kept(r, resampled, &kept, err);
+    tk_curve_free(&resampled);
+    if (rc || !kept) {
+        r->schedule.resolved_at = rope;
+        return rc;
+    }
     return resample_to(r, (size_t)want, err);
 }
 
