@@ -616,6 +616,20 @@ static int restart(tk_run *r, tk_curve *curve, size_t count, int polish, tk_erro
     return resampled ? TK_OK : tk_type_check(r, "an escape's deformation", err);
 }
 
+/* Whether `curve` resampled to `count` vertices would keep the run's
+ * type (*kept), without changing anything. */
+static int resampled_keeps(tk_run *r, const tk_curve *curve, size_t count, bool *kept,
+                           tk_error *err)
+{
+    tk_curve *resampled = NULL;
+    *kept = false;
+    int rc = tk_curve_resample_total(curve, count, &resampled, err);
+    if (!rc)
+        rc = tk_type_kept(r, resampled, kept, err);
+    tk_curve_free(&resampled);
+    return rc;
+}
+
 /* A loose try (turned inside out, or deformed far) restarts on the loose
  * levels, as a loose start does, if its resampled curve keeps the type;
  * else on the coarsest level (*count, already that level's).  The count
@@ -633,12 +647,8 @@ static int go_loose(tk_run *r, const tk_curve *curve, double rope, size_t *count
         return rc;
     r->schedule.coarse_level = r->schedule.coarse_levels + loose;
     size_t want = level_count(r, fmax(rope, reckoned_ropelength(&m)));
-    tk_curve *resampled = NULL;
     bool kept = false;
-    rc = tk_curve_resample_total(curve, want, &resampled, err);
-    if (!rc)
-        rc = tk_type_kept(r, resampled, &kept, err);
-    tk_curve_free(&resampled);
+    rc = resampled_keeps(r, curve, want, &kept, err);
     if (!rc && kept) {
         r->schedule.loose = loose;
         *count = want;
@@ -795,12 +805,8 @@ int tk_schedule_before_step(tk_run *r, tk_error *err)
      * 9.45, on a loose try's level at 47 vertices, failed its job that
      * way): where they would, the polygon stays, until the ropelength
      * has fallen by as much again */
-    tk_curve *resampled = NULL;
     bool kept = false;
-    rc = tk_curve_resample_total(r->shared.curve, (size_t)want, &resampled, err);
-    if (!rc)
-        rc = tk_type_kept(r, resampled, &kept, err);
-    tk_curve_free(&resampled);
+    rc = resampled_keeps(r, r->shared.curve, (size_t)want, &kept, err);
     if (rc || !kept) {
         r->schedule.resolved_at = rope;
         return rc;
