@@ -49,7 +49,12 @@ static bool apart(const tk_curve *c, tk_edge a, tk_edge b, tk_closest *cl)
     return true;
 }
 
-double tk_relax_energy(const tk_curve *c, const tk_curve *target, double pull, double *grad)
+/* E (and its gradient into grad, unless NULL), and the least distance
+ * between edges that share no vertex into *gap, unless NULL: the pairs
+ * E sums over are those the gap is over, so a step of tk_relax measures
+ * both in one pass over them. */
+static double energy(const tk_curve *c, const tk_curve *target, double pull, double *grad,
+                     double *gap)
 {
     size_t m = tk_curve_edge_count(c);
     double length = tk_curve_length(c), h = length / (double)m, h2 = h * h;
@@ -63,6 +68,8 @@ double tk_relax_energy(const tk_curve *c, const tk_curve *target, double pull, d
             tk_closest cl;
             if (!apart(c, a, b, &cl))
                 continue;
+            if (gap)
+                *gap = fmin(*gap, cl.dist);
             double r2 = cl.dist * cl.dist;
             repulsion += h2 / r2;
             if (!grad)
@@ -117,6 +124,11 @@ double tk_relax_energy(const tk_curve *c, const tk_curve *target, double pull, d
     return repulsion + springs + pulled;
 }
 
+double tk_relax_energy(const tk_curve *c, const tk_curve *target, double pull, double *grad)
+{
+    return energy(c, target, pull, grad, NULL);
+}
+
 double tk_relax_gap(const tk_curve *c)
 {
     size_t m = tk_curve_edge_count(c);
@@ -160,14 +172,15 @@ int tk_relax(const tk_curve *c, const tk_curve *target, double pull, int iterati
     }
     double length = tk_curve_length(c), centre[3];
     tk_curve_centroid(c, centre);
-    double energy = tk_relax_energy(x, target, pull, grad), window = energy;
+    double gap = INFINITY;
+    double e = energy(x, target, pull, grad, &gap), window = e;
     double alpha = INFINITY; /* the next step's largest move */
     int taken = 0;
     for (int it = 0; it < iterations; it++) {
         double largest = 0.0;
         for (size_t v = 0; v < c->nvert; v++)
             largest = fmax(largest, sqrt(tk_dot3(grad + 3 * v, grad + 3 * v)));
-        double move = fmin(alpha, RELAX_MOVE * tk_relax_gap(x));
+        double move = fmin(alpha, RELAX_MOVE * gap);
         if (!(largest > 0.0) || !(move > 1e-12 * length))
             break;
         for (size_t k = 0; k < 3 * c->nvert; k++)
@@ -183,19 +196,20 @@ int tk_relax(const tk_curve *c, const tk_curve *target, double pull, int iterati
             tk_curve_scale(trial, length / tk_curve_length(trial));
             tk_curve_translate(trial, centre);
         }
-        if (!(tk_relax_energy(trial, target, pull, NULL) < energy)) {
+        if (!(energy(trial, target, pull, NULL, NULL) < e)) {
             alpha = move / 2.0;
             continue;
         }
         tk_curve *swap = x;
         x = trial;
         trial = swap;
-        energy = tk_relax_energy(x, target, pull, grad);
+        gap = INFINITY;
+        e = energy(x, target, pull, grad, &gap);
         alpha = move * RELAX_GROW;
         if (++taken % RELAX_WINDOW == 0) {
-            if (window - energy < RELAX_STOP * window)
+            if (window - e < RELAX_STOP * window)
                 break;
-            window = energy;
+            window = e;
         }
     }
     free(grad);
