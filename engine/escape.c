@@ -305,19 +305,24 @@ static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far,
  * crossings gets two or three tries in 60 s, and with the near one first
  * the catalogue's 9.38, 10.110 and 10.148 tried only near ones and ended
  * at 82.88, 96.13 and 83.59 (resolution 5, loose 2), their first turned
- * try at 81.83, 90.04 and 79.37.  An explored turned or far try starts
- * on the loose levels (the loose option) as a loose start does, and is
- * judged on the coarsest level as every try is: catalogue 10.70 (near
- * tries first) ended at 91.64, still falling, with its turned try
- * started on the coarsest level, and at 89.25 with it started on the
- * loose levels.  A try on the final polygon starts on the coarsest level
- * all the same: it comes late, with little of the budget left, and the
- * loose levels took it all; catalogue 10.124 (resolution 5, 120 s) had
- * its fine turned try begin at step 40,987 of 68,249 and still on its
- * loose levels when the reserve began, and ended at 71.0571; with fine
- * tries on the coarsest level, at 71.0007 (T(3,5)'s basin), and 10.70,
- * 9.38, 10.110 and 10.148 (60 s) at 89.2501, 81.8273, 90.0431 and
- * 79.3706 against 89.2502, 82.8762, 90.0348 and 79.3706. */
+ * try at 81.83, 90.04 and 79.37.  A turned or far try starts on the
+ * loose levels (the loose option) as a loose start does, and is judged
+ * on the coarsest level as every try is: catalogue 10.70 (near tries
+ * first) ended at 91.64, still falling, with its turned try started on
+ * the coarsest level, and at 89.25 with it started on the loose levels.
+ * For a while tries on the final polygon started on the coarsest level
+ * all the same: their loose levels had followed the ropelength of the
+ * best curve, not their own (schedule.c, restart), and took the rest of
+ * the budget (catalogue 10.124, resolution 5, 120 s: 71.0571).  On the
+ * coarsest level a turned curve, autoscaled about three times as long
+ * as the best, comes down slowly: catalogue 10.34's turned try on the
+ * final polygon spent 22 s of a 60 s run there and was given up at 96.1.
+ * Since each try follows its own ropelength, 10.124 reaches T(3,5)'s
+ * basin with its turned try on the final polygon on the loose levels
+ * (71.0037; 71.0007 on the coarsest), and of 15 catalogue knots of 9
+ * and 10 crossings (60 s) 13 end within 5e-5 of where they did with
+ * those tries on the coarsest level, 10.34 at 88.278 against 88.844 and
+ * 10.154 at 82.654 against 82.921. */
 enum { TRY_TURNED, TRY_FAR, TRY_NEAR, TRY_KINDS };
 
 /* The turned curve is relaxed on TURN_RESOLUTION vertices a unit of
@@ -327,8 +332,8 @@ enum { TRY_TURNED, TRY_FAR, TRY_NEAR, TRY_KINDS };
 
 /* Try number `index` (explored, or on the final polygon) from `best` (of
  * the given thickness and ropelength) into *out; *turned says whether it
- * was turned, *loose whether it starts on the loose levels (an explored
- * turned or far one).  The first turn is about the centroid itself, the later
+ * was turned, *loose whether it starts on the loose levels (a turned or
+ * far one).  The first turn is about the centroid itself, the later
  * ones about points drawn near it (the stream draws the same either way):
  * catalogue 10.124 turned about its centroid tightened to 71.0024 and
  * 71.0012 in 60 s (resolution 5, two runs of bench/catalogue); runs
@@ -337,8 +342,7 @@ enum { TRY_TURNED, TRY_FAR, TRY_NEAR, TRY_KINDS };
  * about the centroid at 71.00266 and 71.00279 (each through a turned try
  * on the final polygon, from 71.058). */
 static int try_curve(tk_run *r, const tk_curve *best, double thickness, double rope, int index,
-                     bool explored, tk_curve **out, double *amplitude, bool *turned, bool *loose,
-                     tk_error *err)
+                     tk_curve **out, double *amplitude, bool *turned, bool *loose, tk_error *err)
 {
     int kind = index % TRY_KINDS;
     *turned = false;
@@ -346,7 +350,7 @@ static int try_curve(tk_run *r, const tk_curve *best, double thickness, double r
      * behind: a far deformation instead */
     if (kind == TRY_TURNED && best->npins)
         kind = TRY_FAR;
-    *loose = explored && kind != TRY_NEAR;
+    *loose = kind != TRY_NEAR;
     if (kind != TRY_TURNED)
         return deformed(r, best, thickness, kind == TRY_FAR, out, amplitude, err);
     double offset[3];
@@ -489,7 +493,7 @@ static int explore_next(tk_run *r, tk_error *err)
     bool turned = false;
     bool loose = false;
     rc = try_curve(r, r->escape.explored, r->escape.explored_thickness, r->escape.explored_rope,
-                   r->escape.explore_tries, true, &curve, &amplitude, &turned, &loose, err);
+                   r->escape.explore_tries, &curve, &amplitude, &turned, &loose, err);
     tk_escape *e = rc ? NULL : log_entry(r, err);
     if (!e) {
         tk_curve_free(&curve);
@@ -584,8 +588,8 @@ int tk_escape_before_step(tk_run *r, tk_error *err)
     int fine = tk_escape_tries(r) - r->escape.explore_tries;
     bool turned = false, loose = false;
     int rc = try_curve(r, r->escape.best, r->escape.best_report.thickness,
-                       r->escape.best_report.ropelength, fine, false, &curve, &amplitude, &turned,
-                       &loose, err);
+                       r->escape.best_report.ropelength, fine, &curve, &amplitude, &turned, &loose,
+                       err);
     tk_escape *e = rc ? NULL : log_entry(r, err);
     if (!e) {
         tk_curve_free(&curve);

@@ -90,9 +90,8 @@
  * to 0.8 diameters long, and resampling keeps the type (none of the
  * catalogue's 398 files nor 50 tightened curves changed type resampled
  * at 0.3 a unit).  Tries are still judged on the coarsest level
- * (tk_escape_judged_here), and near ones and those on the final polygon
- * start there (explored turned and far ones start on the loose levels,
- * go_loose): with the loose levels as the
+ * (tk_escape_judged_here), and near ones start there (turned and far
+ * ones start on the loose levels, go_loose): with the loose levels as the
  * coarsest, tries were ranked on polygons of 37 vertices for 8_19, and
  * catalogue 8.19 ended in the basin 0.06% above the one it had reached
  * (61.06702 against 61.02827, bench/starts, 60 s). */

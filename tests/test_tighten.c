@@ -1783,9 +1783,9 @@ END_TEST
  * reckoned from the same ropelength; a run resumed during an escape
  * keeps it too.  With the loose option the first tightening starts that
  * many halvings below the coarse level (0.625 and 1.25 a unit for 2) and
- * passes through them, and so do the explored turned and far tries;
- * every try is judged on the coarse level, and near ones and those on
- * the final polygon start there.
+ * passes through them, and so do the turned and far tries, explored or
+ * on the final polygon; every try is judged on the coarse level, and
+ * near ones start there.
  * T(2,5) on the round torus at resolution 5: its start is half as long
  * again as the tight knot. */
 static void loose_start_escapes(int loose, long steps)
@@ -1827,15 +1827,16 @@ static void loose_start_escapes(int loose, long steps)
     size_t nh = 0;
     const tk_step_report *h = tk_run_history(run, &nh);
     size_t restarts = 0, refinements = 0, plateau = 0, loose_levels = 0, loose_tries = 0;
+    size_t fine_loose = 0;
     double lowest = INFINITY;
     for (size_t i = 1; i < nh; i++) {
         int k = h[i].escapes - 1;
         /* the kinds take turns: turned, far, near; the first two are
          * loose tries, on the loose levels where the run has them, their
-         * count reckoned from at least the reference, when explored; on
-         * the final polygon every try starts on the coarse level */
+         * count reckoned from at least the reference, explored or on the
+         * final polygon */
         int kind = k < 0 ? -1 : (k - (e[k].explored ? 0 : (int)explored)) % 3;
-        bool loosened = loose && kind >= 0 && kind != 2 && e[k].explored;
+        bool loosened = loose && kind >= 0 && kind != 2;
         if (h[i].escapes > h[i - 1].escapes && e[k].explored) {
             /* explored: the lowest curve's polygon, the first plateau's
              * (turned: the coarse polygon of the lowest ropelength) */
@@ -1853,11 +1854,14 @@ static void loose_start_escapes(int loose, long steps)
             /* an escape: back to the coarse level of the same reference,
              * or a loose level of at least that reference */
             ck_assert_int_eq(e[k].turned, kind == 0);
-            if (loosened)
+            if (loosened) {
                 ck_assert_uint_ge(h[i].vertices, (size_t)ceil(ldexp(2.5, -loose) * reference));
-            else
+                ck_assert_uint_lt(h[i].vertices, again);
+            } else {
                 ck_assert_uint_eq(h[i].vertices, again);
+            }
             loose_tries += loosened;
+            fine_loose += loosened;
             restarts++;
         } else if (h[i].restarts > h[i - 1].restarts && k >= 0 && e[k].explored) {
             /* exploring over: the lowest curve on its own ropelength's coarse polygon */
@@ -1899,6 +1903,8 @@ static void loose_start_escapes(int loose, long steps)
     printf("explored tries: %zu; the lowest explored ropelength %.6f; %zu loose tries\n",
            explored, lowest, loose_tries);
     ck_assert(loose ? loose_tries > 0 : loose_tries == 0);
+    /* the two tries on the final polygon, turned and far, on the loose levels */
+    ck_assert_uint_eq(fine_loose, loose ? 2 : 0);
     /* resumed during the second escape, it ends on the same polygon */
     tk_resume at;
     tk_run *second = interrupted(run, tk_run_latest(run)->step + 5, &at);
@@ -1917,9 +1923,9 @@ START_TEST(a_loose_start_keeps_its_final_count_through_escapes)
 }
 END_TEST
 
-START_TEST(loose_levels_come_first_and_tries_start_coarse)
+START_TEST(loose_levels_come_first_for_every_loose_try)
 {
-    if (quick() && tkt_skip("loose_levels_come_first_and_tries_start_coarse", LONG_RUN))
+    if (quick() && tkt_skip("loose_levels_come_first_for_every_loose_try", LONG_RUN))
         return;
     loose_start_escapes(2, 20000);
 }
@@ -2711,7 +2717,7 @@ int main(void)
     tcase_add_test(tc, a_refined_tight_polygon_is_restored_without_rescaling);
     tcase_add_test(tc, a_loose_curve_is_kept_at_the_tube);
     tcase_add_test(tc, a_loose_start_keeps_its_final_count_through_escapes);
-    tcase_add_test(tc, loose_levels_come_first_and_tries_start_coarse);
+    tcase_add_test(tc, loose_levels_come_first_for_every_loose_try);
     tcase_add_test(tc, a_loose_coarse_level_follows_the_ropelength);
     tcase_add_test(tc, a_loose_start_at_a_vertex_count_escapes_coarse);
     tcase_add_test(tc, a_fine_coarse_level_waits_as_many_more_steps);

@@ -128,7 +128,7 @@
       "with a resolution: the first tightening starts this many halvings below the "        \
       "coarsest level, while 0.6 vertices a unit of ropelength remain, each left at its "    \
       "first stall (a loose start comes down about four times as fast on each); so do "      \
-      "the escapes' explored turned and far tries (0 to 2)")                                 \
+      "the escapes' turned and far tries (0 to 2)")                                          \
     X(escapes, INT, 8, 0, 1000, "escapes",                                                   \
       "most escapes: each time the ropelength all but stops falling on the final polygon "   \
       "(or has crawled there for a fifth of the budget) before the last fifth of the "       \
