@@ -115,7 +115,8 @@ bool tk_escape_converged(const tk_run *r)
 }
 
 /* The coarsest level, where tries are judged (judge_coarse, explore), is
- * polished before it is left, as the final polygon is: at its first stall
+ * polished before it is left, as the final polygon is (for a twentieth
+ * of the budget at most: JUDGED_SHARE, schedule.c): at its first stall
  * a plateau still falls, slowly, and where it has fallen to ranks the
  * final figure better than where it stalled.  T(3,4) at 489 vertices
  * (600 s) settled on curves whose 245-vertex polygons stalled between
@@ -321,8 +322,9 @@ static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far,
  * basin with its turned try on the final polygon on the loose levels
  * (71.0037; 71.0007 on the coarsest), and of 15 catalogue knots of 9
  * and 10 crossings (60 s) 13 end within 5e-5 of where they did with
- * those tries on the coarsest level, 10.34 at 88.278 against 88.844 and
- * 10.154 at 82.654 against 82.921. */
+ * those tries on the coarsest level; 10.34 and 10.154 end lower (88.278
+ * and 82.654 against 88.844 and 82.921), through their explored try, the
+ * turn being cheaper (bench/FIGURES.md). */
 enum { TRY_TURNED, TRY_FAR, TRY_NEAR, TRY_KINDS };
 
 /* The turned curve is relaxed on TURN_RESOLUTION vertices a unit of
@@ -396,12 +398,21 @@ static int try_curve(tk_run *r, const tk_curve *best, double thickness, double r
  * reckoned from a looser curve and can be finer than its own ropelength's
  * coarsest level: catalogue 8.19 at resolution 5 stopped at 61.13 on 203
  * vertices, where 153 are its own, and its tries there (a far one took
- * 10 s) explored for the whole quarter of a 120 s run.  More than
+ * 10 s) explored for the whole first quarter of a 120 s run.  More than
  * EXPLORE_RESOLVE finer, it is put back on its own polygon first and its
  * plateau there found again: the tries and the lowest then compare on one
- * polygon, and 8.19's three tries ended exploring at 17.7 s. */
-#define EXPLORE_SHARE 0.25
-#define EXPLORE_FAILS 3
+ * polygon, and 8.19's three tries ended exploring at 17.7 s.  Half the
+ * budget and five tries, not a quarter and three, since a try's
+ * coarsest level is left after a twentieth of the budget's polishing
+ * (schedule.c, JUDGED_SHARE) and a try costs about 10 s in 60 at 10
+ * crossings: of 15 catalogue knots of 9 and 10 crossings (resolution 5,
+ * 60 s), the excess over the lowest any run reached summed to 2.9% with
+ * both, 4.6% with the coarsest level left early alone (counted then from
+ * the level's start), 10.7% with neither; 10.104 ended at 89.238 against
+ * 90.598, 10.76 at 88.832 against 89.390, 10.34 at 87.655 against
+ * 86.902. */
+#define EXPLORE_SHARE 0.5
+#define EXPLORE_FAILS 5
 #define EXPLORE_GAIN 1e-4
 #define EXPLORE_CRITICAL 0.1
 #define EXPLORE_RESOLVE 0.05

@@ -172,6 +172,8 @@ struct tk_run {
         int polish_level;    /* times the ropelength has all but stopped falling */
         size_t polish_from;  /* history entries before the last change of
                                 level or resampling */
+        size_t polish_began; /* history entries before the level's first
+                                stall (with polish_level > 0) */
         double resolved_at;  /* ropelength at the last re-resolution */
         double start_ropelength; /* of the input, before any resampling, by its
                                     self-distance (the vertex counts' reference) */

@@ -2098,7 +2098,7 @@ static size_t window_at(const tk_step_report *h, size_t i)
  * window at report i; a move-on shows as report i + 1's count or
  * restarts.  The report where it moved on, or 0 if it did not. */
 static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t from, bool polished,
-                                   size_t *first_stall)
+                                   double cap, size_t *first_stall)
 {
     int level = 0;
     *first_stall = 0;
@@ -2109,9 +2109,15 @@ static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t fr
             critical = h[k].residual < 1e-3;
         bool stall = fall_over(h, from, i, window) < 1e-4 * pow(1.0 / 3.0, level) || critical;
         bool moved = h[i + 1].vertices != h[i].vertices || h[i + 1].restarts != h[i].restarts;
-        ck_assert_msg(moved == (stall && level == (polished ? 4 : 0)),
+        /* (a level where tries are judged is also left `cap` steps after
+         * its first stall: the watch at report i's step sees report i - 1,
+         * and counts from the report of the step that stalled) */
+        bool capped = cap > 0.0 && *first_stall > 0 &&
+                      (double)(h[i - 1].step - h[*first_stall].step) >= cap;
+        ck_assert_msg(moved == ((stall && level == (polished ? 4 : 0)) || capped),
                       "step %ld at level %d (since report %zu): %s, %s", h[i].step, level, from,
-                      stall ? "stalled" : "going on", moved ? "moved on" : "stayed");
+                      stall ? "stalled" : capped ? "capped" : "going on",
+                      moved ? "moved on" : "stayed");
         if (moved)
             return i;
         if (stall) {
@@ -2126,7 +2132,7 @@ static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t fr
 /* The trefoil from the round torus (200 vertices) set up to be tightened
  * at 600 vertices, coarse to fine from 150, with a step budget too large
  * for any level's share to end it. */
-static tk_run *torus_trefoil_at_600(int escapes, tk_curve **c, tk_options *o)
+static tk_run *torus_trefoil_at_600(int escapes, long steps, tk_curve **c, tk_options *o)
 {
     ck_assert_int_eq(tk_generate_torus(2, 3, 200, c, NULL), TK_OK);
     *o = (tk_options)TK_OPTIONS_INIT;
@@ -2134,7 +2140,7 @@ static tk_run *torus_trefoil_at_600(int escapes, tk_curve **c, tk_options *o)
     o->vertices = 600;
     o->escapes = escapes;
     o->loose = 0; /* the coarse levels alone */
-    o->max_steps = 1000000;
+    o->max_steps = steps;
     tk_run *run = NULL;
     tk_error err;
     ck_assert_int_eq(tk_run_new(*c, o, &run, &err), TK_OK);
@@ -2157,7 +2163,7 @@ START_TEST(a_fine_coarse_level_waits_as_many_more_steps)
         return;
     tk_curve *c = NULL;
     tk_options o;
-    tk_run *run = torus_trefoil_at_600(0, &c, &o);
+    tk_run *run = torus_trefoil_at_600(0, 1000000, &c, &o);
     tk_error err;
     while (tk_run_curve(run)->nvert < o.vertices && tk_run_latest(run)->step < 20000)
         ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
@@ -2166,7 +2172,7 @@ START_TEST(a_fine_coarse_level_waits_as_many_more_steps)
     const tk_step_report *h = tk_run_history(run, &nh);
     double most = 1.0;
     /* every level, the final one too (which does not move on) */
-    while ((i = coarse_level_checked(h, nh, from, false, &stall)) > 0) {
+    while ((i = coarse_level_checked(h, nh, from, false, 0.0, &stall)) > 0) {
         size_t window = window_at(h, i);
         printf("T(2,3) at 600: the %zu-vertex level moved on at step %ld after %zu steps "
                "(window %zu), ropelength %.5f\n",
@@ -2184,16 +2190,17 @@ START_TEST(a_fine_coarse_level_waits_as_many_more_steps)
 END_TEST
 
 /* With escapes, the coarsest level is where the tries are judged
- * (escape.c), so a try's is polished before it is left; the first
- * tightening's moves on at its first stall, as without escapes, to the
- * first explored try.  The same trefoil as above. */
-START_TEST(the_coarsest_level_of_a_try_is_polished_first)
+ * (escape.c), so a try's is polished before it is left, or until the try
+ * has spent a twentieth of the budget polishing it (JUDGED_SHARE,
+ * schedule.c); the first tightening's moves on at its first stall, as
+ * without escapes, to the first explored try.  The same trefoil as
+ * above, with a budget of `steps`; returns the steps the try spent on
+ * the level from its first stall. */
+static long polished_try(long steps)
 {
-    if (quick() && tkt_skip("the_coarsest_level_of_a_try_is_polished_first", LONG_RUN))
-        return;
     tk_curve *c = NULL;
     tk_options o;
-    tk_run *run = torus_trefoil_at_600(1, &c, &o);
+    tk_run *run = torus_trefoil_at_600(1, steps, &c, &o);
     tk_error err;
     size_t nh = 0;
     const tk_step_report *h = tk_run_history(run, &nh);
@@ -2204,21 +2211,48 @@ START_TEST(the_coarsest_level_of_a_try_is_polished_first)
         h = tk_run_history(run, &nh);
     }
     size_t stall = 0;
-    size_t first = coarse_level_checked(h, nh, 0, false, &stall);
+    size_t first = coarse_level_checked(h, nh, 0, false, 0.0, &stall);
     ck_assert_uint_gt(first, 0);
     size_t ne = 0;
     const tk_escape *e = tk_run_escapes(run, &ne);
     ck_assert(ne == 1 && e[0].explored && h[first + 1].escapes == 1);
-    size_t tried = coarse_level_checked(h, nh, first + 1, true, &stall);
+    size_t tried = coarse_level_checked(h, nh, first + 1, true, 0.05 * (double)steps, &stall);
     ck_assert_uint_gt(tried, 0);
     ck_assert(e[0].coarse == h[tried].ropelength);
-    printf("T(2,3) at 600, escapes: the first tightening left its 150-vertex level at step %ld "
-           "(%.5f); the explored try's level first stalled at step %ld (%.5f) and moved on "
-           "polished at step %ld (%.5f)\n",
-           h[first].step, h[first].ropelength, h[stall].step, h[stall].ropelength,
-           h[tried].step, h[tried].ropelength);
+    long spent = h[tried].step - h[stall].step;
+    printf("T(2,3) at 600, escapes, %ld steps: the first tightening left its 150-vertex level "
+           "at step %ld (%.5f); the explored try's level first stalled at step %ld (%.5f) and "
+           "moved on at step %ld (%.5f), %ld steps after that stall\n",
+           steps, h[first].step, h[first].ropelength, h[stall].step, h[stall].ropelength,
+           h[tried].step, h[tried].ropelength, spent);
     tk_run_free(&run);
     tk_curve_free(&c);
+    return spent;
+}
+
+START_TEST(the_coarsest_level_of_a_try_is_polished_first)
+{
+    if (quick() && tkt_skip("the_coarsest_level_of_a_try_is_polished_first", LONG_RUN))
+        return;
+    /* (a budget too large for the twentieth to end it) */
+    long spent = polished_try(1000000);
+    ck_assert_int_lt(spent, 50000);
+}
+END_TEST
+
+/* The same with a budget whose twentieth ends the try's polishing first:
+ * the level is left then, polished or not (coarse_level_checked). */
+START_TEST(a_try_leaves_its_coarsest_level_after_a_twentieth_of_the_budget)
+{
+    if (quick() &&
+        tkt_skip("a_try_leaves_its_coarsest_level_after_a_twentieth_of_the_budget", LONG_RUN))
+        return;
+    long whole = polished_try(1000000);
+    /* a twentieth of the budget is half the polishing */
+    long steps = 10 * whole;
+    long spent = polished_try(steps);
+    ck_assert_int_lt(spent, whole);
+    ck_assert_int_ge(spent, steps / 20);
 }
 END_TEST
 
@@ -2722,6 +2756,7 @@ int main(void)
     tcase_add_test(tc, a_loose_start_at_a_vertex_count_escapes_coarse);
     tcase_add_test(tc, a_fine_coarse_level_waits_as_many_more_steps);
     tcase_add_test(tc, the_coarsest_level_of_a_try_is_polished_first);
+    tcase_add_test(tc, a_try_leaves_its_coarsest_level_after_a_twentieth_of_the_budget);
     tcase_add_test(tc, unknot_and_unlink_are_handled);
     tcase_add_test(tc, hopf_link_tightens_towards_8_pi);
     tcase_add_test(tc, generated_hopf_link_tightens_to_8_pi);

@@ -135,7 +135,7 @@
       "budget, the best curve so far is changed at random (in turn: turned inside out "      \
       "about a point near its centre, deformed and loosened many times over, deformed a "    \
       "little) and tightened again; the last fifth polishes the best curve; the "            \
-      "result is the best curve found; before that, in the first quarter of the budget, "    \
+      "result is the best curve found; before that, in the first half of the budget, "       \
       "as many tries again explore the coarsest polygon alone, from the lowest curve found " \
       "there (0: none)")                                                                     \
     X(seed, SEED, 1, 0, 9007199254740991.0, "seed",                                          \
