@@ -2096,7 +2096,8 @@ static size_t window_at(const tk_step_report *h, size_t i)
  * level moves it on (a coarse polygon keeps all four: 0.3 h^2 is above
  * the options' 3e-4).  A level that begins at step i's watch starts its
  * window at report i; a move-on shows as report i + 1's count or
- * restarts.  The report where it moved on, or 0 if it did not. */
+ * restarts.  Polished, it also moves on `cap` steps (0: none) after its
+ * first stall.  The report where it moved on, or 0 if it did not. */
 static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t from, bool polished,
                                    double cap, size_t *first_stall)
 {
@@ -2130,8 +2131,8 @@ static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t fr
 }
 
 /* The trefoil from the round torus (200 vertices) set up to be tightened
- * at 600 vertices, coarse to fine from 150, with a step budget too large
- * for any level's share to end it. */
+ * at 600 vertices, coarse to fine from 150, with a budget of `steps`
+ * (1,000,000: too large for any level's share to end it). */
 static tk_run *torus_trefoil_at_600(int escapes, long steps, tk_curve **c, tk_options *o)
 {
     ck_assert_int_eq(tk_generate_torus(2, 3, 200, c, NULL), TK_OK);
