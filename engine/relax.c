@@ -131,16 +131,8 @@ double tk_relax_energy(const tk_curve *c, const tk_curve *target, double pull, d
 
 double tk_relax_gap(const tk_curve *c)
 {
-    size_t m = tk_curve_edge_count(c);
     double gap = INFINITY;
-    for (size_t i = 0; i < m; i++) {
-        tk_edge a = tk_curve_edge(c, i);
-        for (size_t j = i + 1; j < m; j++) {
-            tk_closest cl;
-            if (apart(c, a, tk_curve_edge(c, j), &cl))
-                gap = fmin(gap, cl.dist);
-        }
-    }
+    (void)energy(c, NULL, 0.0, NULL, &gap);
     return gap;
 }
 
