@@ -302,8 +302,11 @@ json_t *tk_json_invariants(const tk_invariants *inv)
             json_array_append_new(row, json_integer((json_int_t)inv->linking[a * n + b]));
         json_array_append_new(linking, row);
     }
-    return json_pack("{s:o, s:o, s:o, s:o, s:b}", "alexander", alexander, "alexander_text",
-                     text, "determinants", det, "linking", linking, "complete", inv->complete);
+    json_t *link = inv->link_known ? json_integer((json_int_t)inv->link_determinant)
+                                   : json_null();
+    return json_pack("{s:o, s:o, s:o, s:o, s:o, s:b}", "alexander", alexander, "alexander_text",
+                     text, "determinants", det, "link_determinant", link, "linking", linking,
+                     "complete", inv->complete);
 }
 
 char *tk_json_dump(const json_t *value, bool indent)

@@ -77,11 +77,13 @@ json_t *tk_json_contacts(const tk_curve *c, const tk_strut *struts, size_t nstru
 
 /* The knot or link type of a curve (tk/invariants.h):
  *   {"alexander": [[1, -1, 1], ...], "alexander_text": ["1 - t + t^2", ...],
- *    "determinants": [3, ...], "linking": [[0, 1], [1, 0]], "complete": true}
+ *    "determinants": [3, ...], "link_determinant": 2,
+ *    "linking": [[0, 1], [1, 0]], "complete": true}
  * One entry per component in the first three: the Alexander polynomial's
  * coefficients of 1, t, t^2, ... (Delta(1) = 1), the same as text, and
  * |Delta(-1)|; null for a component whose type is not known (open, or
- * too many crossings).  "linking" is the symmetric matrix of linking
+ * too many crossings).  "link_determinant" is the whole link's (null when
+ * not known).  "linking" is the symmetric matrix of linking
  * numbers (0 on the diagonal and for open components).  JSON null when
  * inv is NULL or has no components (not computed). */
 json_t *tk_json_invariants(const tk_invariants *inv);

@@ -1,6 +1,7 @@
 /* tightknot: knot and link invariants (see include/tk/invariants.h). */
 #include "tk/invariants.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -127,14 +128,15 @@ static void frame(uint64_t *s, double e1[3], double e2[3], double e3[3])
 }
 
 /* Whether the pictures of edges i and j (i < j, not neighbours) of the
- * projected polygon p (n vertices; x, y and height each) cross, appended
+ * projected polygons p (x, y and height of each vertex; edge i runs from
+ * vertex i to vertex next[i]) cross, appended
  * to *list if they do; TK_ENUMERIC when the projection is not generic
  * there. */
-static int test_pair(const double *p, size_t n, size_t i, size_t j, crossing **list, size_t *m,
-                     size_t *cap, tk_error *err)
+static int test_pair(const double *p, const size_t *next, size_t i, size_t j, crossing **list,
+                     size_t *m, size_t *cap, tk_error *err)
 {
-    const double *a = p + 3 * i, *b = p + 3 * ((i + 1) % n);
-    const double *q = p + 3 * j, *d = p + 3 * ((j + 1) % n);
+    const double *a = p + 3 * i, *b = p + 3 * next[i];
+    const double *q = p + 3 * j, *d = p + 3 * next[j];
     double rx = b[0] - a[0], ry = b[1] - a[1], sx = d[0] - q[0], sy = d[1] - q[1];
     double den = rx * sy - ry * sx;
     double qx = q[0] - a[0], qy = q[1] - a[1];
@@ -199,12 +201,12 @@ static void grid_free(grid *g)
     free(g->box);
 }
 
-static int grid_build(const double *p, size_t n, grid *g, tk_error *err)
+static int grid_build(const double *p, const size_t *next, size_t n, grid *g, tk_error *err)
 {
     *g = (grid){0};
     double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}, length = 0.0;
     for (size_t i = 0; i < n; i++) {
-        const double *a = p + 3 * i, *b = p + 3 * ((i + 1) % n);
+        const double *a = p + 3 * i, *b = p + 3 * next[i];
         for (int k = 0; k < 2; k++) {
             lo[k] = fmin(lo[k], a[k]);
             hi[k] = fmax(hi[k], a[k]);
@@ -226,7 +228,7 @@ static int grid_build(const double *p, size_t n, grid *g, tk_error *err)
     if (!g->start || !g->box)
         return tk_error_set(err, TK_ENOMEM, "out of memory for a projection's grid");
     for (size_t i = 0; i < n; i++) {
-        const double *a = p + 3 * i, *b = p + 3 * ((i + 1) % n);
+        const double *a = p + 3 * i, *b = p + 3 * next[i];
         double *bx = g->box + 4 * i;
         bx[0] = fmin(a[0], b[0]) - widen;
         bx[1] = fmin(a[1], b[1]) - widen;
@@ -265,27 +267,48 @@ static int grid_build(const double *p, size_t n, grid *g, tk_error *err)
     return TK_OK;
 }
 
-/* The crossings of the knot seen along e3: for each pair of non-adjacent
- * edges whose pictures cross, where along the knot the under and the over
- * strand pass.  Returns TK_OK, TK_ENUMERIC for a projection that is not
- * generic, or TK_ENOMEM. */
-static int find_crossings(const tk_curve *c, size_t comp, const double e1[3], const double e2[3],
-                          const double e3[3], crossing **out, size_t *count, tk_error *err)
+/* The crossings of closed components lo .. hi - 1 of c seen along e3:
+ * for each pair of edges, not neighbours, whose pictures cross, where
+ * the under and the over strand pass.  A position is the index of its
+ * edge among the components' edges taken in order, plus the parameter
+ * along it, so the positions of component lo + k run from
+ * first[k] to first[k + 1] (first, hi - lo + 1 entries, may be NULL).
+ * Returns TK_OK, TK_ENUMERIC for a projection that is not generic, or
+ * TK_ENOMEM. */
+static int find_crossings(const tk_curve *c, size_t lo, size_t hi, const double e1[3],
+                          const double e2[3], const double e3[3], size_t *first, crossing **out,
+                          size_t *count, tk_error *err)
 {
-    size_t n = tk_curve_comp_vertices(c, comp);
+    size_t n = 0;
+    for (size_t k = lo; k < hi; k++)
+        n += tk_curve_comp_vertices(c, k);
     double *p = malloc(3 * n * sizeof *p);
+    size_t *next = malloc(n * sizeof *next);
     crossing *list = NULL;
     size_t m = 0, cap = 0;
-    if (!p)
+    if (!p || !next) {
+        free(p);
+        free(next);
         return tk_error_set(err, TK_ENOMEM, "out of memory for a projection");
-    for (size_t i = 0; i < n; i++) {
-        const double *x = tk_curve_vertex(c, tk_curve_vertex_index(c, comp, i));
-        p[3 * i] = tk_dot3(x, e1);
-        p[3 * i + 1] = tk_dot3(x, e2);
-        p[3 * i + 2] = tk_dot3(x, e3);
     }
+    size_t at = 0;
+    for (size_t k = lo; k < hi; k++) {
+        size_t nk = tk_curve_comp_vertices(c, k);
+        if (first)
+            first[k - lo] = at;
+        for (size_t i = 0; i < nk; i++) {
+            const double *x = tk_curve_vertex(c, tk_curve_vertex_index(c, k, i));
+            p[3 * (at + i)] = tk_dot3(x, e1);
+            p[3 * (at + i) + 1] = tk_dot3(x, e2);
+            p[3 * (at + i) + 2] = tk_dot3(x, e3);
+            next[at + i] = i + 1 < nk ? at + i + 1 : at;
+        }
+        at += nk;
+    }
+    if (first)
+        first[hi - lo] = n;
     grid g;
-    int rc = grid_build(p, n, &g, err);
+    int rc = grid_build(p, next, n, &g, err);
     for (size_t k = 0; !rc && k < g.nx * g.ny; k++)
         for (size_t u = g.start[k]; !rc && u < g.start[k + 1]; u++)
             for (size_t v = u + 1; !rc && v < g.start[k + 1]; v++) {
@@ -295,7 +318,7 @@ static int find_crossings(const tk_curve *c, size_t comp, const double e1[3], co
                     i = j;
                     j = t;
                 }
-                if (j == i + 1 || (i == 0 && j == n - 1))
+                if (next[i] == j || next[j] == i)
                     continue; /* neighbours */
                 const double *bi = g.box + 4 * i, *bj = g.box + 4 * j;
                 double lx = fmax(bi[0], bj[0]), ly = fmax(bi[1], bj[1]);
@@ -307,10 +330,11 @@ static int find_crossings(const tk_curve *c, size_t comp, const double e1[3], co
                         grid_index(lx, g.x0, g.cell, g.nx) !=
                     k)
                     continue;
-                rc = test_pair(p, n, i, j, &list, &m, &cap, err);
+                rc = test_pair(p, next, i, j, &list, &m, &cap, err);
             }
     grid_free(&g);
     free(p);
+    free(next);
     if (rc) {
         free(list);
         return rc;
@@ -326,20 +350,27 @@ static int by_under(const void *pa, const void *pb)
     return a < b ? -1 : (a > b ? 1 : 0);
 }
 
-/* The arc a position lies on: arc k runs from undercrossing k to k+1
- * (cyclically), so it is the last undercrossing at or before the
- * position, and the last arc before the first. */
+/* The arc a position lies on, among the arcs of one component whose
+ * undercrossings are x[lo .. hi) (sorted, hi > lo): arc k runs from
+ * undercrossing k to the next (cyclically), so it is the last
+ * undercrossing at or before the position, and the last arc before the
+ * first. */
+static size_t arc_in(const crossing *x, size_t lo, size_t hi, double position)
+{
+    size_t start = lo, end = hi; /* first index whose under > position */
+    while (start < end) {
+        size_t mid = start + (end - start) / 2;
+        if (x[mid].under <= position)
+            start = mid + 1;
+        else
+            end = mid;
+    }
+    return start == lo ? hi - 1 : start - 1;
+}
+
 static size_t arc_of(const crossing *x, size_t m, double position)
 {
-    size_t lo = 0, hi = m; /* first index whose under > position */
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (x[mid].under <= position)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo == 0 ? m - 1 : lo - 1;
+    return arc_in(x, 0, m, position);
 }
 
 static unsigned long long mulmod(unsigned long long a, unsigned long long b,
@@ -402,18 +433,22 @@ static long long symmetric(unsigned long long r, unsigned long long p)
     return r > p / 2 ? -(long long)(p - r) : (long long)r;
 }
 
-/* A diagram of closed component comp: the crossings of the fewest-
- * crossing projection among the first DIAGRAMS_COMPARED generic ones
- * (drawn from seed), sorted along the knot by their undercrossings.  The
- * invariants' cost grows with the crossings, not the vertices. */
-static int diagram(const tk_curve *c, size_t comp, unsigned long long seed, crossing **out,
-                   size_t *count, tk_error *err)
+/* A diagram of closed components lo .. hi - 1: the crossings of the
+ * fewest-crossing projection among the first DIAGRAMS_COMPARED generic
+ * ones (drawn from seed), sorted by their undercrossings' positions
+ * (find_crossings: component lo + k's run from first[k] to first[k + 1];
+ * first may be NULL).  The invariants' cost grows with the crossings,
+ * not the vertices.  `what` names the components in messages. */
+static int diagram(const tk_curve *c, size_t lo, size_t hi, unsigned long long seed,
+                   size_t *first, const char *what, crossing **out, size_t *count, tk_error *err)
 {
     *out = NULL;
     *count = 0;
-    if (comp >= c->ncomp || !c->closed[comp])
-        return tk_error_set(err, TK_EINVAL, "a knot invariant needs a closed component (%zu)",
-                            comp);
+    for (size_t k = lo; k < hi; k++)
+        if (k >= c->ncomp || !c->closed[k])
+            return tk_error_set(err, TK_EINVAL,
+                                "a knot or link invariant needs closed components (%zu is not)",
+                                k);
     uint64_t state = seed;
     int generic = 0;
     for (int attempt = 0; attempt < PROJECTION_TRIES && generic < DIAGRAMS_COMPARED; attempt++) {
@@ -421,7 +456,7 @@ static int diagram(const tk_curve *c, size_t comp, unsigned long long seed, cros
         frame(&state, e1, e2, e3);
         crossing *x = NULL;
         size_t m = 0;
-        int rc = find_crossings(c, comp, e1, e2, e3, &x, &m, err);
+        int rc = find_crossings(c, lo, hi, e1, e2, e3, first, &x, &m, err);
         if (rc == TK_ENUMERIC)
             continue;
         if (rc) {
@@ -439,28 +474,81 @@ static int diagram(const tk_curve *c, size_t comp, unsigned long long seed, cros
     }
     if (!generic)
         return tk_error_set(err, TK_ENUMERIC,
-                            "no generic projection of component %zu in %d tries: strands (nearly) "
-                            "meet",
-                            comp, PROJECTION_TRIES);
+                            "no generic projection of %s in %d tries: strands (nearly) meet", what,
+                            PROJECTION_TRIES);
     if (*count > TK_INVARIANT_MAX_CROSSINGS) {
         free(*out);
         *out = NULL;
         return tk_error_set(err, TK_ELIMIT,
-                            "component %zu has %zu crossings in its simplest projection found, "
-                            "more than the %d its invariants are computed for",
-                            comp, *count, TK_INVARIANT_MAX_CROSSINGS);
+                            "%s has %zu crossings in its simplest projection found, more than "
+                            "the %d its invariants are computed for",
+                            what, *count, TK_INVARIANT_MAX_CROSSINGS);
     }
     if (*count > 1)
         qsort(*out, *count, sizeof **out, by_under);
     return TK_OK;
 }
 
+/* |det| of the colouring matrix of a diagram less its last row and
+ * column: the determinant of the knot or link it shows.  x holds its m
+ * crossings sorted by undercrossing; the undercrossings of component k
+ * are x[block[k] .. block[k + 1]), its positions run from first[k] to
+ * first[k + 1], k < ncomp.  Every component must have an undercrossing.
+ * Crossing i ends arc "in" (the one before it on its component) and
+ * starts arc i; its over-arc is where the over strand lies.  Fox
+ * colouring at t = -1: 2 over - in - out. */
+static int colouring_determinant(const crossing *x, size_t m, const size_t *first,
+                                 const size_t *block, size_t ncomp, const char *what,
+                                 long long *det, tk_error *err)
+{
+    assert(m >= 2);
+    size_t k = m - 1; /* the minor without the last row and column */
+    long long *entries = calloc(m * m, sizeof *entries);
+    long long *minor = calloc(k * k, sizeof *minor);
+    unsigned long long *work = malloc(k * k * sizeof *work);
+    if (!entries || !minor || !work) {
+        free(entries);
+        free(minor);
+        free(work);
+        return tk_error_set(err, TK_ENOMEM, "out of memory for %zu crossings", m);
+    }
+    size_t own = 0; /* the component of crossing i's undercrossing */
+    for (size_t i = 0; i < m; i++) {
+        while (i >= block[own + 1])
+            own++;
+        assert(block[own] < block[own + 1]);
+        size_t top = 0; /* the component of its over strand */
+        while (top + 1 < ncomp && x[i].over >= (double)first[top + 1])
+            top++;
+        size_t over = arc_in(x, block[top], block[top + 1], x[i].over);
+        size_t in = i == block[own] ? block[own + 1] - 1 : i - 1, outgoing = i;
+        entries[i * m + over] += 2;
+        entries[i * m + in] -= 1;
+        entries[i * m + outgoing] -= 1;
+    }
+    for (size_t r = 0; r < k; r++)
+        for (size_t col = 0; col < k; col++)
+            minor[r * k + col] = entries[r * m + col];
+    long long va = symmetric(det_mod(minor, k, PRIME_A, work), PRIME_A);
+    long long vb = symmetric(det_mod(minor, k, PRIME_B, work), PRIME_B);
+    free(entries);
+    free(work);
+    free(minor);
+    if (va != vb)
+        return tk_error_set(err, TK_ENUMERIC, "the determinant of %s exceeds 2^59 (%zu crossings)",
+                            what, m);
+    *det = va < 0 ? -va : va;
+    return TK_OK;
+}
+
 int tk_knot_determinant(const tk_curve *c, size_t comp, unsigned long long seed, long long *det,
                         size_t *crossings, tk_error *err)
 {
+    char what[48];
+    snprintf(what, sizeof what, "component %zu", comp);
     crossing *x = NULL;
     size_t m = 0;
-    int rc = diagram(c, comp, seed, &x, &m, err);
+    int rc = diagram(c, comp, comp + 1, seed, NULL, what, &x, &m, err);
     if (rc)
         return rc;
     if (crossings)
@@ -471,47 +559,49 @@ int tk_knot_determinant(const tk_curve *c, size_t comp, unsigned long long seed,
         *det = 1;
         return TK_OK;
     }
-    size_t k = m - 1; /* the minor without the last row and column */
-    long long *entries = calloc(m * m, sizeof *entries);
-    unsigned long long *work = malloc(k * k * sizeof *work);
-    if (!entries || !work) {
-        free(x);
-        free(entries);
-        free(work);
-        return tk_error_set(err, TK_ENOMEM, "out of memory for %zu crossings", m);
-    }
-    /* Crossing i (sorted by its undercrossing) ends arc i - 1 and starts
-     * arc i; its over-arc is where the over strand lies.  Fox colouring at
-     * t = -1: 2 over - in - out. */
-    for (size_t i = 0; i < m; i++) {
-        size_t over = arc_of(x, m, x[i].over);
-        size_t in = (i + m - 1) % m, outgoing = i;
-        entries[i * m + over] += 2;
-        entries[i * m + in] -= 1;
-        entries[i * m + outgoing] -= 1;
-    }
-    long long *minor = calloc(k * k, sizeof *minor);
-    if (!minor) {
-        free(x);
-        free(entries);
-        free(work);
-        return tk_error_set(err, TK_ENOMEM, "out of memory for %zu crossings", m);
-    }
-    for (size_t r = 0; r < k; r++)
-        for (size_t col = 0; col < k; col++)
-            minor[r * k + col] = entries[r * m + col];
-    long long va = symmetric(det_mod(minor, k, PRIME_A, work), PRIME_A);
-    long long vb = symmetric(det_mod(minor, k, PRIME_B, work), PRIME_B);
+    size_t first[2] = {0, tk_curve_comp_vertices(c, comp)}, block[2] = {0, m};
+    rc = colouring_determinant(x, m, first, block, 1, what, det, err);
     free(x);
-    free(entries);
-    free(work);
-    free(minor);
-    if (va != vb)
-        return tk_error_set(err, TK_ENUMERIC,
-                            "the determinant of component %zu exceeds 2^59 (%zu crossings)", comp,
-                            m);
-    *det = va < 0 ? -va : va;
-    return TK_OK;
+    return rc;
+}
+
+int tk_link_determinant(const tk_curve *c, unsigned long long seed, long long *det,
+                        size_t *crossings, tk_error *err)
+{
+    size_t n = c->ncomp;
+    if (n == 0)
+        return tk_error_set(err, TK_EINVAL, "the link determinant needs a component");
+    size_t *first = malloc((n + 1) * sizeof *first), *block = malloc((n + 1) * sizeof *block);
+    crossing *x = NULL;
+    size_t m = 0;
+    int rc = first && block ? TK_OK : tk_error_set(err, TK_ENOMEM, "out of memory for a link");
+    if (!rc)
+        rc = diagram(c, 0, n, seed, first, "the link", &x, &m, err);
+    if (!rc && crossings)
+        *crossings = m;
+    /* a component with no undercrossing lies above the rest and can be
+     * lifted off them: the link is split, and its determinant 0 (so is a
+     * diagram without crossings of two components or more) */
+    bool split = false;
+    for (size_t k = 0, i = 0; !rc && k <= n; k++) {
+        while (i < m && k < n && x[i].under < (double)first[k])
+            i++;
+        block[k] = k == n ? m : i;
+        if (k > 0 && block[k] == block[k - 1])
+            split = true;
+    }
+    if (!rc) {
+        if (n == 1 && m < 2)
+            *det = 1; /* an unknot's diagram */
+        else if (split)
+            *det = 0;
+        else
+            rc = colouring_determinant(x, m, first, block, n, "the link", det, err);
+    }
+    free(first);
+    free(block);
+    free(x);
+    return rc;
 }
 
 /* ---- the Alexander polynomial ---- */
@@ -609,7 +699,9 @@ int tk_knot_alexander(const tk_curve *c, size_t comp, unsigned long long seed,
 {
     crossing *x = NULL;
     size_t m = 0;
-    int rc = diagram(c, comp, seed, &x, &m, err);
+    char what[48];
+    snprintf(what, sizeof what, "component %zu", comp);
+    int rc = diagram(c, comp, comp + 1, seed, NULL, what, &x, &m, err);
     if (rc)
         return rc;
     if (crossings)
@@ -752,6 +844,22 @@ int tk_invariants_compute(const tk_curve *c, tk_invariants *out, tk_error *err)
             rc = tk_linking_number(c, a, b, &lk, NULL, err);
             out->linking[a * n + b] = out->linking[b * n + a] = lk;
         }
+    /* the link's own determinant tells apart links whose components and
+     * linking numbers agree; a knot's is its component's */
+    bool all_closed = true;
+    for (size_t a = 0; a < n; a++)
+        all_closed = all_closed && c->closed[a];
+    if (!rc && n == 1) {
+        out->link_known = out->knot[0].known;
+        out->link_determinant = out->knot[0].determinant;
+    } else if (!rc && n > 1 && all_closed) {
+        rc = tk_link_determinant(c, INVARIANT_SEED, &out->link_determinant, NULL, err);
+        out->link_known = rc == TK_OK;
+        if (rc == TK_ELIMIT) {
+            out->complete = false;
+            rc = TK_OK;
+        }
+    }
     if (rc)
         tk_invariants_free(out);
     return rc;
@@ -772,6 +880,8 @@ int tk_invariants_copy(const tk_invariants *src, tk_invariants *out, tk_error *e
     memcpy(out->knot, src->knot, n * sizeof *out->knot);
     memcpy(out->linking, src->linking, n * n * sizeof *out->linking);
     out->ncomp = n;
+    out->link_known = src->link_known;
+    out->link_determinant = src->link_determinant;
     out->complete = src->complete;
     return TK_OK;
 }
@@ -829,5 +939,9 @@ int tk_invariants_compare(const tk_invariants *was, const tk_invariants *now, tk
                                     "the link type changed: the linking number of components "
                                     "%zu and %zu was %ld, now %ld",
                                     a, b, was->linking[a * n + b], now->linking[a * n + b]);
+    if (was->link_known && now->link_known && was->link_determinant != now->link_determinant)
+        return tk_error_set(err, TK_ETYPE,
+                            "the link type changed: its determinant was %lld, now %lld",
+                            was->link_determinant, now->link_determinant);
     return TK_OK;
 }

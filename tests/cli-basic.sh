@@ -323,7 +323,7 @@ expect_status 0 "info --json on hopf" "$tk" info --json "$tmp/hopf.vect"
 expect_match '"determinants":\[1,1\],"linking":(\[\[0,1\],\[1,0\]\]|\[\[0,-1\],\[-1,0\]\]),"complete":true' \
     "$tmp/out" "info --json: the Hopf link's linking number"
 expect_status 0 "info (text) on hopf" "$tk" info "$tmp/hopf.vect"
-expect_match ' det 1 1, lk 0-1: -?1$' "$tmp/out" "info: the Hopf link's type column"
+expect_match ' det 1 1, lk 0-1: -?1, link det 2$' "$tmp/out" "info: the Hopf link's type column"
 
 # Standard input as "-", through a pipe.
 "$tk" generate chain 4 | "$tk" info --json - >"$tmp/out" 2>"$tmp/err"

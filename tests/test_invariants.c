@@ -6,6 +6,7 @@
  * scaling, resampling and small perturbations. */
 #include <check.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -515,6 +516,125 @@ START_TEST(the_type_record)
 }
 END_TEST
 
+/* The determinant of a whole link (tk_link_determinant) against Rolfsen's
+ * table and exact values: T(2, n) has n, a chain of k rings (a connected
+ * sum of k - 1 Hopf links) 2^(k - 1), the Borromean rings 16, a split
+ * link 0; the same from every projection (seed), mirrored and moved; a
+ * knot's is its own determinant. */
+static long long link_det_of(const tk_curve *c, unsigned long long seed)
+{
+    long long det = -1;
+    size_t m = 0;
+    tk_error err;
+    ck_assert_msg(tk_link_determinant(c, seed, &det, &m, &err) == TK_OK, "%s", err.message);
+    return det;
+}
+
+START_TEST(link_determinants)
+{
+    tk_curve *c = NULL;
+    for (int n = 2; n <= 8; n++) {
+        ck_assert_int_eq(tk_generate_torus(2, n, 24 * n, &c, NULL), TK_OK);
+        for (unsigned long long seed = 1; seed <= 3; seed++)
+            ck_assert_int_eq(link_det_of(c, seed), n);
+        if (c->ncomp == 1) {
+            long long det = 0;
+            tk_error err;
+            ck_assert_int_eq(tk_knot_determinant(c, 0, 7, &det, NULL, &err), TK_OK);
+            ck_assert_int_eq(link_det_of(c, 7), det);
+        }
+        tk_curve_free(&c);
+    }
+    for (size_t k = 2; k <= 5; k++) {
+        ck_assert_int_eq(tk_generate_chain(k, 32, &c, NULL), TK_OK);
+        ck_assert_int_eq(link_det_of(c, 1), 1LL << (k - 1));
+        tk_curve_free(&c);
+    }
+    ck_assert_int_eq(tk_generate_borromean(60, &c, NULL), TK_OK);
+    ck_assert_int_eq(link_det_of(c, 1), 16);
+    /* one ring moved far off along z: a split link, whatever is above */
+    size_t n = tk_curve_comp_vertices(c, 2);
+    for (size_t i = 0; i < n; i++)
+        c->xyz[3 * (c->offset[2] + i) + 2] += 10.0;
+    for (unsigned long long seed = 1; seed <= 3; seed++)
+        ck_assert_int_eq(link_det_of(c, seed), 0);
+    tk_curve_free(&c);
+    /* the Hopf link mirrored, rotated and disguised */
+    ck_assert_int_eq(tk_generate_hopf(40, &c, NULL), TK_OK);
+    for (size_t i = 0; i < c->nvert; i++)
+        c->xyz[3 * i] = -c->xyz[3 * i];
+    tk_curve *d = NULL;
+    ck_assert_int_eq(tk_generate_disguise(c, 5, 0.05, &d, NULL), TK_OK);
+    ck_assert_int_eq(link_det_of(d, 2), 2);
+    tk_curve_free(&d);
+    tk_curve_free(&c);
+    if (!tkt_catalogue_dir()) {
+        tkt_skip("link_determinants (the catalogue's)", "the catalogue is absent");
+        return;
+    }
+    const struct {
+        const char *name;
+        long long det;
+    } known[] = {{"0.2.1.vect", 0}, {"0.3.1.vect", 0}, {"2.2.1.vect", 2}, {"4.2.1.vect", 4},
+                 {"5.2.1.vect", 8}, {"6.2.1.vect", 6}, {"6.2.2.vect", 10}, {"6.2.3.vect", 12},
+                 {"6.3.2.vect", 16}};
+    for (size_t k = 0; k < sizeof known / sizeof *known; k++) {
+        c = tkt_catalogue_curve(known[k].name);
+        for (unsigned long long seed = 1; seed <= 3; seed++)
+            ck_assert_msg(link_det_of(c, seed) == known[k].det, "%s seed %llu: %lld", known[k].name,
+                          seed, link_det_of(c, seed));
+        tk_curve_free(&c);
+    }
+    /* every closed link of the catalogue: one value from three projections */
+    size_t count = 0, links = 0;
+    char **names = tkt_catalogue_names(&count);
+    for (size_t i = 0; i < count; i++) {
+        c = tkt_catalogue_curve(names[i]);
+        bool closed = c->ncomp > 1;
+        for (size_t a = 0; a < c->ncomp; a++)
+            closed = closed && c->closed[a];
+        if (closed) {
+            long long first = link_det_of(c, 1);
+            ck_assert_msg(link_det_of(c, 2) == first && link_det_of(c, 3) == first, "%s",
+                          names[i]);
+            links++;
+        }
+        tk_curve_free(&c);
+    }
+    tkt_free_names(names, count);
+    ck_assert_uint_ge(links, 100);
+}
+END_TEST
+
+/* Catalogue 6.2.3 and the (2, 4) torus link have two unknotted
+ * components and linking number 2: only the link's determinant (12
+ * against 4) tells them apart, and the type check must. */
+START_TEST(links_that_only_the_link_determinant_tells_apart)
+{
+    if (!tkt_catalogue_dir()) {
+        tkt_skip("links_that_only_the_link_determinant_tells_apart", "the catalogue is absent");
+        return;
+    }
+    const char *pairs[][2] = {{"6.2.3.vect", "4.2.1.vect"}, {"6.2.2.vect", "6.2.1.vect"}};
+    for (size_t k = 0; k < 2; k++) {
+        tk_curve *a = tkt_catalogue_curve(pairs[k][0]), *b = tkt_catalogue_curve(pairs[k][1]);
+        tk_invariants was = TK_INVARIANTS_INIT, now = TK_INVARIANTS_INIT;
+        tk_error err;
+        ck_assert_int_eq(tk_invariants_compute(a, &was, &err), TK_OK);
+        ck_assert_int_eq(tk_invariants_compute(b, &now, &err), TK_OK);
+        ck_assert(was.link_known && now.link_known);
+        ck_assert_int_eq(labs(was.linking[1]), labs(now.linking[1]));
+        ck_assert_int_eq(tk_invariants_compare(&was, &now, &err), TK_ETYPE);
+        ck_assert_msg(strstr(err.message, "the link type changed: its determinant was") != NULL,
+                      "%s", err.message);
+        tk_invariants_free(&was);
+        tk_invariants_free(&now);
+        tk_curve_free(&a);
+        tk_curve_free(&b);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("invariants");
@@ -534,6 +654,8 @@ int main(void)
     tcase_add_test(knots, torus_knot_alexander_polynomials);
     tcase_add_test(knots, catalogue_alexander_polynomials);
     tcase_add_test(knots, the_type_record);
+    tcase_add_test(knots, link_determinants);
+    tcase_add_test(knots, links_that_only_the_link_determinant_tells_apart);
     suite_add_tcase(s, knots);
     return tkt_run_suite(s);
 }

@@ -116,8 +116,9 @@ static const char info_help[] =
     "  type        for a knot its determinant |Delta(-1)| and Alexander\n"
     "              polynomial Delta(t) (normalised so that Delta(1) = 1):\n"
     "              \"det 3, 1 - t + t^2\" is the trefoil; for a link the\n"
-    "              determinant of each component and the linking number of\n"
-    "              each pair: \"det 1 1, lk 0-1: 1\" is the Hopf link.  \"?\"\n"
+    "              determinant of each component, the linking number of\n"
+    "              each pair and the whole link's determinant: \"det 1 1,\n"
+    "              lk 0-1: 1, link det 2\" is the Hopf link.  \"?\"\n"
     "              for what cannot be told (an open component, a projection\n"
     "              with too many crossings, strands that (nearly) meet)\n"
     "\n"
@@ -128,7 +129,8 @@ static const char info_help[] =
     "                    value that is not finite) and invariants:\n"
     "                    {\"alexander\": [[1, -1, 1]] (each component's\n"
     "                    coefficients of 1, t, t^2, ...), \"alexander_text\",\n"
-    "                    \"determinants\", \"linking\" (the matrix of linking\n"
+    "                    \"determinants\", \"link_determinant\" (the whole\n"
+    "                    link's), \"linking\" (the matrix of linking\n"
     "                    numbers), \"complete\"} (null for what cannot be told)\n"
     "  --tolerance EPS   relative tolerance for struts and kinks, >= 0\n"
     "                    (default 1e-4)\n"
@@ -605,8 +607,9 @@ static void print_info_header(int width)
 }
 
 /* The type of c in a few words: "det 3, 1 - t + t^2" for a knot, "det 1 1,
- * lk 0-1: 1" for a link (each component's determinant, each pair's
- * linking number); "?" for what is not known (inv NULL: nothing is). */
+ * lk 0-1: 1, link det 2" for a link (each component's determinant, each
+ * pair's linking number, the whole link's determinant); "?" for what is
+ * not known (inv NULL: nothing is). */
 static void print_type(FILE *f, const tk_curve *c, const tk_invariants *inv)
 {
     if (!inv || inv->ncomp != c->ncomp) {
@@ -638,6 +641,10 @@ static void print_type(FILE *f, const tk_curve *c, const tk_invariants *inv)
             else
                 fputc('?', f);
         }
+    if (inv->link_known)
+        fprintf(f, ", link det %lld", inv->link_determinant);
+    else
+        fputs(", link det ?", f);
 }
 
 /* Measures one file and prints its line; the table's header goes out

@@ -50,7 +50,8 @@ const compact = (n) => (n >= 1e6 && n % 1e5 === 0 ? `${n / 1e6}M` : n >= 1e4 && 
 // A knot or link type (the API's KnotType) in a few words: a knot's
 // Alexander polynomial and determinant, "1 - t + t^2 (det 3)"; a link's
 // linking numbers, its components' determinants and any knotted
-// component's polynomial, "lk 0-1: 1 (det 1 1)".  "?" for what is unknown.
+// component's polynomial, "lk 0-1: 1 (det 1 1; link 2)".  "?" for what is
+// unknown.
 function typeText(k) {
     if (!k) return '–';
     const n = k.determinants.length;
@@ -60,7 +61,8 @@ function typeText(k) {
     for (let a = 0; a < n; a++)
         for (let b = a + 1; b < n; b++) pairs.push(`${a}-${b}: ${k.linking[a][b]}`);
     const knotted = k.alexander_text.map((t, i) => (t != null && t !== '1' ? `; ${i}: ${t}` : '')).join('');
-    return `lk ${pairs.join(', ')} (det ${k.determinants.map((_, i) => det(i)).join(' ')})${knotted}`;
+    const link = k.link_determinant == null ? '?' : `${k.link_determinant}`;
+    return `lk ${pairs.join(', ')} (det ${k.determinants.map((_, i) => det(i)).join(' ')}; link ${link})${knotted}`;
 }
 
 // The type figure: the result's, and the start's beside it when the run

@@ -11,7 +11,13 @@
  * arcs between its undercrossings, and the colouring matrix (each crossing
  * 2 x its over-arc - its two under-arcs); any minor of one order less has
  * the determinant as its absolute value, whatever the projection.  It is
- * 1 for the unknot, 3 for the trefoil, 5 for the figure-eight.
+ * 1 for the unknot, 3 for the trefoil, 5 for the figure-eight.  The same
+ * matrix of a diagram of all the components is the link's: 2 for the
+ * Hopf link, 4 for the (2, 4) torus link, 6 for T(2, 6), 12 for
+ * Rolfsen's 6^2_3, 8 for the Whitehead link, 16 for the Borromean rings,
+ * 0 for a split link.  Two links whose components and linking numbers agree
+ * (6^2_3 and the (2, 4) torus link: unknots, linking number 2) can still
+ * differ there.
  */
 #ifndef TK_INVARIANTS_H
 #define TK_INVARIANTS_H
@@ -51,6 +57,15 @@ int tk_linking_number(const tk_curve *c, size_t a, size_t b, long *lk, double *g
 int tk_knot_determinant(const tk_curve *c, size_t comp, unsigned long long seed, long long *det,
                         size_t *crossings, tk_error *err);
 
+/* The determinant of the whole link c (every component closed): |det|
+ * of the colouring matrix of a diagram of all its components less a row
+ * and a column, from a projection drawn from `seed` as for
+ * tk_knot_determinant; for one component, that knot's determinant.  0
+ * when the diagram shows a split link.  Fails as tk_knot_determinant
+ * does. */
+int tk_link_determinant(const tk_curve *c, unsigned long long seed, long long *det,
+                        size_t *crossings, tk_error *err);
+
 /* The Alexander polynomial of closed component comp seen as a knot:
  * coeff[0..*degree] are its coefficients of 1, t, ..., t^degree,
  * normalised so that coeff[0] != 0 and Delta(1) = 1 (the trefoil's is
@@ -79,10 +94,14 @@ typedef struct tk_invariants {
     tk_knot_type *knot;  /* per component */
     long *linking;       /* ncomp x ncomp, row major, symmetric; 0 on the
                             diagonal and for open components */
-    bool complete;       /* every closed component's knot type is known */
+    bool link_known;     /* false when a component is open or the diagram
+                            of all of them has too many crossings */
+    long long link_determinant; /* tk_link_determinant */
+    bool complete;       /* every closed component's knot type is known,
+                            and the link's determinant */
 } tk_invariants;
 
-#define TK_INVARIANTS_INIT {0, NULL, NULL, false}
+#define TK_INVARIANTS_INIT {0, NULL, NULL, false, 0, false}
 
 /* The invariants of c into *out (freed first).  Fails with TK_ENUMERIC
  * when strands (nearly) meet, TK_ENOMEM; a component with too many
@@ -94,7 +113,8 @@ int tk_invariants_copy(const tk_invariants *src, tk_invariants *out, tk_error *e
 /* TK_OK when `now` has the type `was` had (what either leaves unknown is
  * not compared), else TK_ETYPE with a message naming the first
  * difference ("component 0: the Alexander polynomial was 1 - t + t^2, now
- * 1"). */
+ * 1"): the components' knot types, the linking numbers, then the link's
+ * determinant. */
 int tk_invariants_compare(const tk_invariants *was, const tk_invariants *now, tk_error *err);
 
 /* The polynomial as text, "1 - t + t^2", into buf (always terminated). */

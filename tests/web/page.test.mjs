@@ -390,7 +390,7 @@ test('a torus link generated in the page is thick enough and has its components'
     // T(2,4): two unknots with linking number 2 (its sign by orientation)
     const lk = job.invariants.result.linking[0][1];
     assert.equal(Math.abs(lk), 2);
-    assert.equal(await page.locator('#fig-type').innerText(), `lk 0-1: ${lk} (det 1 1)`);
+    assert.equal(await page.locator('#fig-type').innerText(), `lk 0-1: ${lk} (det 1 1; link 2)`);
     const { body: contacts } = await api(`/v1/jobs/${id}/struts`);
     assert.equal(await page.locator('#contact-map .boundary').count(), 2, 'one boundary line each way');
     assert.equal(await page.locator('#contact-map .strut-mark').count(), contacts.struts.length);
