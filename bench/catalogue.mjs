@@ -16,8 +16,10 @@
 // the spread between the starts that converged (residual below 0.05; the
 // others are listed apart, as still moving), how many of the lowest start's tightenings
 // reached its lowest basin (the job's basins.best_reached; 1: found once),
-// the struts and kinks and seconds of the lowest, the starts whose result's type (measured again with `tightknot
-// info`) is not the file's, the settings.  Then a summary: how many knots
+// the struts and kinks and seconds of the lowest, the starts whose
+// result's type (measured again with `tightknot info`, the link's
+// determinant too) is not the file's, which are left out of the lowest
+// and the spread, the settings.  Then a summary: how many knots
 // have every start within 0.1% of their lowest, the widest spreads, how
 // often the catalogue's own start was the one trapped, and by how much.
 //
@@ -51,7 +53,7 @@
 //   --table-only      write the table and summary from OUT, submit nothing
 
 import { execFileSync, spawn, spawnSync } from 'node:child_process';
-import { existsSync, mkdirSync, readdirSync, readFileSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdirSync, readdirSync, readFileSync, statSync, writeFileSync } from 'node:fs';
 import { cpus } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -140,13 +142,28 @@ const knots = readdirSync(opt.catalogue)
 const mine = knots.filter((n, k) => k % +slice[2] === +slice[1] - 1 && (!opt.only || opt.only.includes(n)));
 
 const info = (file) => JSON.parse(execFileSync(CLI, ['info', '--json', file], { encoding: 'utf8' }));
-// The type as compared: Alexander polynomials, determinants and linking
+// The type as compared: Alexander polynomials, determinants, linking
 // numbers up to sign (a mirror or a reversed component has the same
-// ropelength).
+// ropelength) and the link's determinant (which alone tells 6.2.2 from
+// T(2,6), and 6.2.3 from T(2,4)).
 const typeKey = (inv) => JSON.stringify([inv.alexander, inv.determinants,
-    inv.linking.map((row) => row.map(Math.abs))]);
+    inv.linking.map((row) => row.map(Math.abs)), inv.link_determinant ?? null]);
 const typeText = (inv) => `det ${inv.determinants.join(',')}; ${inv.alexander_text.join(', ')}` +
-    (inv.linking.length > 1 ? `; lk ${inv.linking.map((r) => r.join(' ')).join(' / ')}` : '');
+    (inv.linking.length > 1 ? `; lk ${inv.linking.map((r) => r.join(' ')).join(' / ')}` +
+        `; link det ${inv.link_determinant ?? '?'}` : '');
+
+// The catalogue file's type, kept in STARTS/NAME.type.json; measured again
+// when the kept one predates the link determinant.
+function fileType(name) {
+    const typeFile = join(startsDir, `${name}.type.json`);
+    if (existsSync(typeFile)) {
+        const kept = JSON.parse(readFileSync(typeFile, 'utf8'));
+        if ('link_determinant' in kept) return kept;
+    }
+    const want = info(join(opt.catalogue, `${name}.vect`)).invariants;
+    writeFileSync(typeFile, JSON.stringify(want));
+    return want;
+}
 
 // The parametric forms worth trying for a name K.N or K.C.N (crossings K,
 // C components): whichever of them has the file's type is a start.
@@ -167,26 +184,20 @@ function parametric(name) {
 // Makes the starts of one knot (those not made yet); returns their files.
 function makeStarts(name) {
     const file = join(opt.catalogue, `${name}.vect`);
-    const typeFile = join(startsDir, `${name}.type.json`);
-    let want;
-    if (existsSync(typeFile)) {
-        want = JSON.parse(readFileSync(typeFile, 'utf8'));
-    } else {
-        want = info(file).invariants;
-        writeFileSync(typeFile, JSON.stringify(want));
-    }
+    const want = fileType(name);
     const files = [];
+    // a start made before is checked again: the type compared has grown
     const put = (tag, text, why) => {
         const path = join(startsDir, `${name}@${tag}.vect`);
-        if (!existsSync(path)) {
-            writeFileSync(path + '.part', text);
-            const got = info(path + '.part').invariants;
-            if (typeKey(got) !== typeKey(want)) {
-                console.log(`  ${name}: the ${why} is of another type (${typeText(got)}), not a start`);
-                return;
-            }
-            execFileSync('mv', [path + '.part', path]);
+        const made = existsSync(path);
+        if (!made) writeFileSync(path + '.part', text);
+        const got = info(made ? path : path + '.part').invariants;
+        if (typeKey(got) !== typeKey(want)) {
+            console.log(`  ${name}: the ${why} is of another type (${typeText(got)}), not a start`);
+            execFileSync('rm', ['-f', path, path + '.part']);
+            return;
         }
+        if (!made) execFileSync('mv', [path + '.part', path]);
         files.push(path);
     };
     put('cat', readFileSync(file, 'utf8'), 'catalogue file');
@@ -248,12 +259,13 @@ async function submitAll(server, files) {
 
 // ---- the table
 
+// Every results directory's rows; a start run again in a later
+// directory (a summary written later) replaces its earlier row.
 function readSummary() {
     const rows = new Map();
-    for (const dir of readdirSync(resultsRoot)) {
-        const path = join(resultsRoot, dir, 'summary.tsv');
-        if (existsSync(path)) readRows(path, join(resultsRoot, dir), rows);
-    }
+    const paths = readdirSync(resultsRoot).map((dir) => join(resultsRoot, dir, 'summary.tsv'))
+        .filter(existsSync).sort((a, b) => statSync(a).mtimeMs - statSync(b).mtimeMs);
+    for (const path of paths) readRows(path, dirname(path), rows);
     return rows;
 }
 
@@ -313,8 +325,26 @@ function writeTable() {
         unconverged: [], bySettings: new Map() };
     for (const knot of [...byKnot.keys()].sort(natural)) {
         const starts = byKnot.get(knot).sort((a, b) => natural(a.tag, b.tag));
-        const ok = starts.filter((s) => s.state === 'done' && Number.isFinite(s.ropelength));
+        const done = starts.filter((s) => s.state === 'done' && Number.isFinite(s.ropelength));
         const failed = starts.filter((s) => s.state !== 'done');
+        let type = '', want = null;
+        try {
+            want = fileType(knot);
+            type = typeText(want);
+        } catch { /* not in this catalogue */ }
+        // the type at the end, measured again on each result's curve: a
+        // result of another type (or a start of one, made before the type
+        // compared held the link's determinant) is another link's figure,
+        // left out of the lowest and the spread
+        const changed = want ? done.filter((s) => {
+            try {
+                return typeKey(info(join(s.dir, `${knot}@${s.tag}.vect`)).invariants) !== typeKey(want);
+            } catch {
+                return true;
+            }
+        }).map((s) => s.tag) : [];
+        for (const tag of changed) summary.changed.push(`${knot}@${tag}`);
+        const ok = done.filter((s) => !changed.includes(s.tag));
         for (const s of failed) summary.failed.push(`${knot}@${s.tag}: ${s.state}`);
         if (!ok.length) continue;
         // A start still moving when its time ran out (residual at least
@@ -332,20 +362,6 @@ function writeTable() {
         const spread = 100 * (worst.ropelength - best.ropelength) / best.ropelength;
         const cat = converged.find((s) => s.tag === 'cat');
         const catAbove = cat ? 100 * (cat.ropelength - best.ropelength) / best.ropelength : NaN;
-        let type = '', want = null;
-        try {
-            want = JSON.parse(readFileSync(join(startsDir, `${knot}.type.json`), 'utf8'));
-            type = typeText(want);
-        } catch { /* made by another out directory */ }
-        // the type at the end, measured again on each result's curve
-        const changed = want ? ok.filter((s) => {
-            try {
-                return typeKey(info(join(s.dir, `${knot}@${s.tag}.vect`)).invariants) !== typeKey(want);
-            } catch {
-                return true;
-            }
-        }).map((s) => s.tag) : [];
-        for (const tag of changed) summary.changed.push(`${knot}@${tag}`);
         lines.push([knot, best.components, type, best.vertices,
             ok.map((s) => `${s.tag}=${s.ropelength.toFixed(6)}`).join(' '), best.ropelength.toFixed(6),
             best.tag, spread.toFixed(4), Number.isFinite(catAbove) ? catAbove.toFixed(4) : '',
@@ -395,7 +411,7 @@ function writeTable() {
     for (const [spread, knot, lo, lov, hi, hiv] of widest)
         console.log(`  ${knot}: ${spread.toFixed(3)}% apart (${lo} ${lov.toFixed(4)}, ${hi} ${hiv.toFixed(4)})`);
     for (const f of summary.failed) console.log(`  failed: ${f}`);
-    console.log(`  type at the end: ${summary.changed.length ? `changed in ${summary.changed.join(', ')}`
+    console.log(`  type at the end: ${summary.changed.length ? `another's (left out of the lowest) in ${summary.changed.join(', ')}`
         : 'the file\'s in every result'}`);
 }
 
