@@ -607,8 +607,9 @@ START_TEST(link_determinants)
 END_TEST
 
 /* Catalogue 6.2.3 and the (2, 4) torus link have two unknotted
- * components and linking number 2: only the link's determinant (12
- * against 4) tells them apart, and the type check must. */
+ * components and linking number 2, as 6.2.2 and T(2, 6) have with
+ * linking number 3: only the link's determinant (12 against 4, 10
+ * against 6) tells them apart, and the type check must. */
 START_TEST(links_that_only_the_link_determinant_tells_apart)
 {
     if (!tkt_catalogue_dir()) {
@@ -632,6 +633,30 @@ START_TEST(links_that_only_the_link_determinant_tells_apart)
         tk_curve_free(&a);
         tk_curve_free(&b);
     }
+    /* 6.2.3 resampled to 12 and 13 vertices: the coarse polygon's chords
+     * cut through a strand, and it is the (2, 4) torus link, with the
+     * same components and linking number (a loose level of a run did
+     * this, and ended at T(2,4)'s ropelength) */
+    tk_curve *c = tkt_catalogue_curve("6.2.3.vect");
+    tk_invariants was = TK_INVARIANTS_INIT, now = TK_INVARIANTS_INIT;
+    tk_error err;
+    ck_assert_int_eq(tk_invariants_compute(c, &was, &err), TK_OK);
+    ck_assert_int_eq(was.link_determinant, 12);
+    for (size_t n = 12; n <= 13; n++) {
+        tk_curve *coarse = NULL;
+        ck_assert_int_eq(tk_curve_resample_total(c, n, &coarse, &err), TK_OK);
+        ck_assert_int_eq(tk_invariants_compute(coarse, &now, &err), TK_OK);
+        ck_assert_int_eq(now.linking[1], was.linking[1]);
+        ck_assert_int_eq(now.knot[0].determinant, 1);
+        ck_assert_int_eq(now.knot[1].determinant, 1);
+        ck_assert_int_eq(now.link_determinant, 4);
+        ck_assert_int_eq(tk_invariants_compare(&was, &now, &err), TK_ETYPE);
+        ck_assert_str_eq(err.message, "the link type changed: its determinant was 12, now 4");
+        tk_curve_free(&coarse);
+    }
+    tk_invariants_free(&was);
+    tk_invariants_free(&now);
+    tk_curve_free(&c);
 }
 END_TEST
 
