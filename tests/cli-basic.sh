@@ -296,7 +296,7 @@ expect_value components 3 "$tmp/out" "borromean"
 # and determinant 3; the figure-eight's -1 + 3t - t^2 from a disguised
 # start; the Hopf link's linking number +-1, the same both ways.
 expect_status 0 "info --json on the trefoil" "$tk" info --json "$tmp/trefoil.vect"
-expect_match '"invariants":\{"alexander":\[\[1,-1,1\]\],"alexander_text":\["1 - t \+ t\^2"\],"determinants":\[3\],"linking":\[\[0\]\],"complete":true\}' \
+expect_match '"invariants":\{"alexander":\[\[1,-1,1\]\],"alexander_text":\["1 - t \+ t\^2"\],"determinants":\[3\],"link_determinant":3,"linking":\[\[0\]\],"complete":true\}' \
     "$tmp/out" "info --json: the trefoil's type"
 expect_status 0 "info (text) on the trefoil" "$tk" info "$tmp/trefoil.vect"
 expect_match 'trefoil\.vect +1 +[0-9]+ .* det 3, 1 - t \+ t\^2$' "$tmp/out" "info: the trefoil's type column"
@@ -320,8 +320,8 @@ expect_match 'not coprime' "$tmp/err" "Lissajous: the frequencies named"
 expect_status 1 "Lissajous retracing itself" "$tk" generate lissajous 3 2 5 0 0 0
 expect_match 'passes through itself' "$tmp/err" "Lissajous: the phases named"
 expect_status 0 "info --json on hopf" "$tk" info --json "$tmp/hopf.vect"
-expect_match '"determinants":\[1,1\],"linking":(\[\[0,1\],\[1,0\]\]|\[\[0,-1\],\[-1,0\]\]),"complete":true' \
-    "$tmp/out" "info --json: the Hopf link's linking number"
+expect_match '"determinants":\[1,1\],"link_determinant":2,"linking":(\[\[0,1\],\[1,0\]\]|\[\[0,-1\],\[-1,0\]\]),"complete":true' \
+    "$tmp/out" "info --json: the Hopf link's linking number and determinant"
 expect_status 0 "info (text) on hopf" "$tk" info "$tmp/hopf.vect"
 expect_match ' det 1 1, lk 0-1: -?1, link det 2$' "$tmp/out" "info: the Hopf link's type column"
 

@@ -17,6 +17,7 @@ const TREFOIL = {
     alexander: [[1, -1, 1]],
     alexander_text: ['1 - t + t^2'],
     determinants: [3],
+    link_determinant: 3,
     linking: [[0]],
     complete: true,
 };
@@ -52,6 +53,7 @@ describe('a job\'s invariants', () => {
         assert.ok(Math.abs(lk[0][1]) === 1 && lk[1][0] === lk[0][1] && lk[0][0] === 0 && lk[1][1] === 0,
             `the Hopf link's linking matrix: ${JSON.stringify(lk)}`);
         assert.deepEqual(h.invariants.result.determinants, [1, 1]);
+        assert.equal(h.invariants.result.link_determinant, 2, 'the Hopf link\'s own determinant');
     });
 
     test('resampling at resolution 0.1 would unknot the trefoil: the job fails with the engine\'s reason', async () => {

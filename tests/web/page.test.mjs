@@ -388,9 +388,10 @@ test('a torus link generated in the page is thick enough and has its components'
     assert.equal(job.name, 'T(2,4)');
     await page.waitForSelector('#job[data-phase="final"]');
     // T(2,4): two unknots with linking number 2 (its sign by orientation)
+    // and the link's determinant 4
     const lk = job.invariants.result.linking[0][1];
     assert.equal(Math.abs(lk), 2);
-    assert.equal(await page.locator('#fig-type').innerText(), `lk 0-1: ${lk} (det 1 1; link 2)`);
+    assert.equal(await page.locator('#fig-type').innerText(), `lk 0-1: ${lk} (det 1 1; link 4)`);
     const { body: contacts } = await api(`/v1/jobs/${id}/struts`);
     assert.equal(await page.locator('#contact-map .boundary').count(), 2, 'one boundary line each way');
     assert.equal(await page.locator('#contact-map .strut-mark').count(), contacts.struts.length);
