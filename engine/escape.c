@@ -240,12 +240,13 @@ void tk_escape_reserve(tk_run *r)
 
 /* A deformation is applied at once: every vertex moves along a straight
  * line from the best curve to the deformed one.  Its type is checked at
- * the end, but the invariants (each component's Alexander polynomial, the
- * linking numbers) cannot tell every link apart: the Borromean rings have
- * the invariants of three unlinked rings, and catalogue 6.3.2 tightened
- * at 630 vertices for 600 s (bench/table2.sh) ended at 39.6, three rings
- * pulled apart by a deformation, where the Borromean rings' tight value is
- * 58.006.  So the path itself must be an isotopy (tk_struts_path_embedded),
+ * the end, but the invariants cannot tell every link apart.  With each
+ * component's Alexander polynomial and the linking numbers alone the
+ * Borromean rings had the invariants of three unlinked rings (the link's
+ * determinant, 16 against 0, now tells these two apart), and catalogue
+ * 6.3.2 tightened at 630 vertices for 600 s (bench/table2.sh) ended at
+ * 39.6, three rings pulled apart by a deformation, where the Borromean
+ * rings' tight value is 58.006.  So the path itself must be an isotopy (tk_struts_path_embedded),
  * or a smaller deformation is tried. */
 
 /* The largest deformation of `best` (of the given thickness) that keeps

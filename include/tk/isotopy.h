@@ -9,7 +9,9 @@
  * features are smaller than its new edges, and the invariants cannot
  * catch every change: catalogue 9.2.3 (two unknots, linking number -1)
  * turned inside out and resampled on 101 vertices that way became the
- * Hopf link, whose invariants are the same, and tightened to 8 pi.
+ * Hopf link, whose components and linking number are the same (only the
+ * link's determinant, 30 against 2, tells them apart), and tightened to
+ * 8 pi.
  */
 #ifndef TK_ISOTOPY_H
 #define TK_ISOTOPY_H
