@@ -489,6 +489,20 @@ static int diagram(const tk_curve *c, size_t lo, size_t hi, unsigned long long s
     return TK_OK;
 }
 
+/* The diagram of component comp alone (diagram), its crossing count
+ * into *crossings (may be NULL), its name for messages into what. */
+#define KNOT_NAME 48
+static int knot_diagram(const tk_curve *c, size_t comp, unsigned long long seed,
+                        char what[KNOT_NAME], crossing **x, size_t *m, size_t *crossings,
+                        tk_error *err)
+{
+    snprintf(what, KNOT_NAME, "component %zu", comp);
+    int rc = diagram(c, comp, comp + 1, seed, NULL, what, x, m, err);
+    if (!rc && crossings)
+        *crossings = *m;
+    return rc;
+}
+
 /* |det| of the colouring matrix of a diagram less its last row and
  * column: the determinant of the knot or link it shows.  x holds its m
  * crossings sorted by undercrossing; the undercrossings of component k
@@ -544,15 +558,12 @@ static int colouring_determinant(const crossing *x, size_t m, const size_t *firs
 int tk_knot_determinant(const tk_curve *c, size_t comp, unsigned long long seed, long long *det,
                         size_t *crossings, tk_error *err)
 {
-    char what[48];
-    snprintf(what, sizeof what, "component %zu", comp);
+    char what[KNOT_NAME];
     crossing *x = NULL;
     size_t m = 0;
-    int rc = diagram(c, comp, comp + 1, seed, NULL, what, &x, &m, err);
+    int rc = knot_diagram(c, comp, seed, what, &x, &m, crossings, err);
     if (rc)
         return rc;
-    if (crossings)
-        *crossings = m;
     if (m < 2) {
         /* no crossing, or one (a kink): a diagram of the unknot */
         free(x);
@@ -697,15 +708,12 @@ int tk_knot_alexander(const tk_curve *c, size_t comp, unsigned long long seed,
                       long long coeff[TK_ALEXANDER_MAX_DEGREE + 1], int *degree,
                       size_t *crossings, tk_error *err)
 {
+    char what[KNOT_NAME];
     crossing *x = NULL;
     size_t m = 0;
-    char what[48];
-    snprintf(what, sizeof what, "component %zu", comp);
-    int rc = diagram(c, comp, comp + 1, seed, NULL, what, &x, &m, err);
+    int rc = knot_diagram(c, comp, seed, what, &x, &m, crossings, err);
     if (rc)
         return rc;
-    if (crossings)
-        *crossings = m;
     if (m < 2) {
         free(x);
         coeff[0] = 1;
