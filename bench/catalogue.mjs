@@ -55,7 +55,7 @@
 import { execFileSync, spawn, spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, readdirSync, readFileSync, statSync, writeFileSync } from 'node:fs';
 import { cpus } from 'node:os';
-import { dirname, join, resolve } from 'node:path';
+import { basename, dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 const argv = process.argv.slice(2);
@@ -129,6 +129,9 @@ const startsDir = join(out, 'starts');
 const resultsRoot = join(out, 'results');
 const resultsDir = join(resultsRoot, opt.only ? `only-${opt.only.join('_')}`
     : `slice-${slice[1]}-of-${slice[2]}`);
+// the daemon's figures of each slice run, committed beside the table (the
+// results directories are not)
+const DAEMON_LOG = opt.table.replace(/(\.tsv)?$/, '-daemon.tsv');
 mkdirSync(startsDir, { recursive: true });
 mkdirSync(resultsDir, { recursive: true });
 
@@ -295,102 +298,135 @@ function kinksOf(start, dir) {
 }
 
 const CONVERGED = 0.05;
+const COLUMNS = ['name', 'components', 'type', 'vertices', 'starts', 'lowest', 'lowest.start',
+    'spread.%', 'cat.above.%', 'lowest.reached', 'struts', 'kinks', 'seconds', 'failed', 'type.changed',
+    'unconverged', 'settings'];
+
+// One knot's row of the table from its results here: the row's fields by
+// COLUMNS' names, or null when no result of the file's type is done.
+// Failed starts' states go to `failed` (the table keeps their count).
+function rowOf(knot, starts, failedStates) {
+    starts.sort((a, b) => natural(a.tag, b.tag));
+    const done = starts.filter((s) => s.state === 'done' && Number.isFinite(s.ropelength));
+    const failed = starts.filter((s) => s.state !== 'done');
+    for (const s of failed) failedStates.push(`${knot}@${s.tag}: ${s.state}`);
+    let type = '', want = null;
+    try {
+        want = fileType(knot);
+        type = typeText(want);
+    } catch { /* not in this catalogue */ }
+    // the type at the end, measured again on each result's curve: a
+    // result of another type (or a start of one, made before the type
+    // compared held the link's determinant) is another link's figure,
+    // left out of the lowest and the spread
+    const changed = want ? done.filter((s) => {
+        try {
+            return typeKey(info(join(s.dir, `${knot}@${s.tag}.vect`)).invariants) !== typeKey(want);
+        } catch {
+            return true;
+        }
+    }).map((s) => s.tag) : [];
+    const ok = done.filter((s) => !changed.includes(s.tag));
+    if (!ok.length) return null;
+    // A start still moving when its time ran out (residual at least
+    // CONVERGED: a loose start whose polygon was reckoned from its own
+    // length, say) has not reached a basin to compare: the spread and
+    // the catalogue's excess are over the converged starts, and the
+    // others are listed apart.
+    const converged = ok.filter((s) => s.residual < CONVERGED);
+    const judged = converged.length ? converged : ok;
+    const best = judged.reduce((a, b) => (b.ropelength < a.ropelength ? b : a));
+    const worst = judged.reduce((a, b) => (b.ropelength > a.ropelength ? b : a));
+    const cat = converged.find((s) => s.tag === 'cat');
+    // (slices run before settings.txt was kept: these options without loose)
+    let settings;
+    try {
+        settings = readFileSync(join(best.dir, 'settings.txt'), 'utf8').trim();
+    } catch {
+        settings = settingsText(0);
+    }
+    return {
+        name: knot, components: best.components, type, vertices: best.vertices,
+        starts: ok.map((s) => `${s.tag}=${s.ropelength.toFixed(6)}`).join(' '),
+        lowest: best.ropelength.toFixed(6), 'lowest.start': best.tag,
+        'spread.%': (100 * (worst.ropelength - best.ropelength) / best.ropelength).toFixed(4),
+        'cat.above.%': cat ? (100 * (cat.ropelength - best.ropelength) / best.ropelength).toFixed(4) : '',
+        'lowest.reached': best.reached, struts: best.struts, kinks: kinksOf(`${knot}@${best.tag}`, best.dir),
+        seconds: ok.reduce((t, s) => t + s.seconds, 0).toFixed(0), failed: failed.length,
+        'type.changed': want ? changed.join(' ') || 'none' : '',
+        unconverged: ok.filter((s) => !(s.residual < CONVERGED)).map((s) => s.tag).join(' '),
+        settings,
+    };
+}
+
+// The table as committed: its rows by name.  A knot with no result here
+// keeps its row, so that a clean clone (without the curves of the runs
+// before) fills the table on, slice by slice.
+function tableRows() {
+    const rows = new Map();
+    if (!existsSync(opt.table)) return rows;
+    const [head, ...body] = readFileSync(opt.table, 'utf8').trim().split('\n');
+    const names = head.split('\t');
+    for (const line of body) {
+        const f = line.split('\t');
+        rows.set(f[0], Object.fromEntries(names.map((n, k) => [n, f[k] ?? ''])));
+    }
+    return rows;
+}
 
 function writeTable() {
-    const rows = readSummary();
     const byKnot = new Map();
-    for (const r of rows.values()) {
+    for (const r of readSummary().values()) {
         const at = r.name.lastIndexOf('@');
         if (at < 0) continue;
         const knot = r.name.slice(0, at);
         if (!byKnot.has(knot)) byKnot.set(knot, []);
         byKnot.get(knot).push({ ...r, tag: r.name.slice(at + 1) });
     }
-    // (slices run before cpu_time ran alone on the machine, where the wall
-    // clock and the processor's agree)
-    // a slice's own settings (settings.txt), else those of the slices
-    // before it was kept: these options without loose
-    const settingsOf = (dir) => {
-        try {
-            return readFileSync(join(dir, 'settings.txt'), 'utf8').trim();
-        } catch {
-            return settingsText(0);
-        }
-    };
-    const settingsSeen = new Set();
-    const lines = [['name', 'components', 'type', 'vertices', 'starts', 'lowest', 'lowest.start',
-        'spread.%', 'cat.above.%', 'lowest.reached', 'struts', 'kinks', 'seconds', 'failed', 'type.changed',
-        'unconverged', 'settings'].join('\t')];
-    const summary = { knots: 0, compared: 0, agree: 0, spreads: [], catTrapped: [], failed: [], changed: [],
-        unconverged: [], bySettings: new Map() };
-    for (const knot of [...byKnot.keys()].sort(natural)) {
-        const starts = byKnot.get(knot).sort((a, b) => natural(a.tag, b.tag));
-        const done = starts.filter((s) => s.state === 'done' && Number.isFinite(s.ropelength));
-        const failed = starts.filter((s) => s.state !== 'done');
-        let type = '', want = null;
-        try {
-            want = fileType(knot);
-            type = typeText(want);
-        } catch { /* not in this catalogue */ }
-        // the type at the end, measured again on each result's curve: a
-        // result of another type (or a start of one, made before the type
-        // compared held the link's determinant) is another link's figure,
-        // left out of the lowest and the spread
-        const changed = want ? done.filter((s) => {
-            try {
-                return typeKey(info(join(s.dir, `${knot}@${s.tag}.vect`)).invariants) !== typeKey(want);
-            } catch {
-                return true;
-            }
-        }).map((s) => s.tag) : [];
-        for (const tag of changed) summary.changed.push(`${knot}@${tag}`);
-        const ok = done.filter((s) => !changed.includes(s.tag));
-        for (const s of failed) summary.failed.push(`${knot}@${s.tag}: ${s.state}`);
-        if (!ok.length) continue;
-        // A start still moving when its time ran out (residual at least
-        // CONVERGED: a loose start whose polygon was reckoned from its own
-        // length, say) has not reached a basin to compare: the spread and
-        // the catalogue's excess are over the converged starts, and the
-        // others are listed apart.
-        const converged = ok.filter((s) => s.residual < CONVERGED);
-        const unconverged = ok.filter((s) => !(s.residual < CONVERGED));
-        for (const s of unconverged)
-            summary.unconverged.push(`${knot}@${s.tag} (${s.ropelength.toFixed(2)}, ${s.vertices} vertices, residual ${s.residual.toFixed(2)})`);
-        const judged = converged.length ? converged : ok;
-        const best = judged.reduce((a, b) => (b.ropelength < a.ropelength ? b : a));
-        const worst = judged.reduce((a, b) => (b.ropelength > a.ropelength ? b : a));
-        const spread = 100 * (worst.ropelength - best.ropelength) / best.ropelength;
-        const cat = converged.find((s) => s.tag === 'cat');
-        const catAbove = cat ? 100 * (cat.ropelength - best.ropelength) / best.ropelength : NaN;
-        lines.push([knot, best.components, type, best.vertices,
-            ok.map((s) => `${s.tag}=${s.ropelength.toFixed(6)}`).join(' '), best.ropelength.toFixed(6),
-            best.tag, spread.toFixed(4), Number.isFinite(catAbove) ? catAbove.toFixed(4) : '',
-            best.reached, best.struts, kinksOf(`${knot}@${best.tag}`, best.dir),
-            ok.reduce((t, s) => t + s.seconds, 0).toFixed(0), failed.length,
-            want ? changed.join(' ') || 'none' : '', unconverged.map((s) => s.tag).join(' '),
-            settingsOf(best.dir)].join('\t'));
-        const settings = lines.at(-1).split('\t').at(-1);
-        settingsSeen.add(settings);
-        if (!summary.bySettings.has(settings)) summary.bySettings.set(settings, { knots: 0, compared: 0, agree: 0, catTrapped: 0 });
-        const group = summary.bySettings.get(settings);
-        group.knots++;
-        group.compared += converged.length > 1;
-        group.agree += converged.length > 1 && spread <= 0.1;
-        group.catTrapped += catAbove > 0.1;
-        summary.knots++;
-        if (converged.length > 1) summary.compared++;
-        if (converged.length > 1 && spread <= 0.1) summary.agree++;
-        summary.spreads.push([spread, knot, best.tag, best.ropelength, worst.tag, worst.ropelength]);
-        if (catAbove > 0.1) summary.catTrapped.push([catAbove, knot]);
+    const rows = tableRows();
+    const failedStates = [];
+    for (const [knot, starts] of byKnot) {
+        const row = rowOf(knot, starts, failedStates);
+        if (row) rows.set(knot, row);
     }
+    const ordered = [...rows.keys()].sort(natural).map((k) => rows.get(k));
     mkdirSync(resolve(opt.table, '..'), { recursive: true });
-    writeFileSync(opt.table, lines.join('\n') + '\n');
-    const pct = (n) => (summary.knots ? (100 * n / summary.knots).toFixed(1) : '-');
-    console.log(`table: ${opt.table}, ${summary.knots} of ${knots.length} knots and links (${[...settingsSeen].join('; ')})`);
+    writeFileSync(opt.table, [COLUMNS, ...ordered.map((r) => COLUMNS.map((c) => r[c]))]
+        .map((f) => f.join('\t')).join('\n') + '\n');
+
+    // the summary, from the table's rows alone (those kept and those made here)
+    const summary = { compared: 0, agree: 0, spreads: [], catTrapped: [], changed: [], unconverged: [],
+        failed: 0, bySettings: new Map() };
+    for (const r of ordered) {
+        const values = r.starts.split(' ').map((t) => t.split('='));
+        const moving = r.unconverged ? r.unconverged.split(' ') : [];
+        const judged = values.filter(([tag]) => !moving.includes(tag));
+        const pick = judged.length ? judged : values;
+        const worst = pick.reduce((a, b) => (+b[1] > +a[1] ? b : a));
+        const spread = +r['spread.%'], catAbove = r['cat.above.%'] === '' ? NaN : +r['cat.above.%'];
+        const compared = judged.length > 1;
+        for (const tag of moving) summary.unconverged.push(`${r.name}@${tag}`);
+        if (r['type.changed'] && r['type.changed'] !== 'none')
+            for (const tag of r['type.changed'].split(' ')) summary.changed.push(`${r.name}@${tag}`);
+        summary.failed += +r.failed || 0;
+        if (!summary.bySettings.has(r.settings)) summary.bySettings.set(r.settings, { knots: 0, compared: 0, agree: 0, catTrapped: 0 });
+        const group = summary.bySettings.get(r.settings);
+        group.knots++;
+        group.compared += compared;
+        group.agree += compared && spread <= 0.1;
+        group.catTrapped += catAbove > 0.1;
+        summary.compared += compared;
+        summary.agree += compared && spread <= 0.1;
+        summary.spreads.push([spread, r.name, r['lowest.start'], +r.lowest, worst[0], +worst[1]]);
+        if (catAbove > 0.1) summary.catTrapped.push([catAbove, r.name]);
+    }
+    const n = ordered.length;
+    const pct = (k) => (n ? (100 * k / n).toFixed(1) : '-');
+    console.log(`table: ${opt.table}, ${n} of ${knots.length} knots and links (${[...summary.bySettings.keys()].join('; ')})`);
     console.log(`  with two converged starts or more: ${summary.compared}; every converged start within ` +
         `0.1% of the lowest: ${summary.agree} (${summary.compared ? (100 * summary.agree / summary.compared).toFixed(1) : '-'}%)`);
     console.log(`  starts still moving when their time ran out (residual >= ${CONVERGED}): ` +
-        `${summary.unconverged.length}` + (summary.unconverged.length ? `: ${summary.unconverged.join('; ')}` : ''));
+        `${summary.unconverged.length}` + (summary.unconverged.length ? `: ${summary.unconverged.join(', ')}` : ''));
     console.log(`  the catalogue's start more than 0.1% above the lowest: ${summary.catTrapped.length} ` +
         `(${pct(summary.catTrapped.length)}%)` + (summary.catTrapped.length
         ? `, by ${Math.min(...summary.catTrapped.map((t) => t[0])).toFixed(2)}% to ` +
@@ -398,19 +434,20 @@ function writeTable() {
     for (const [settings, g] of summary.bySettings)
         console.log(`  ${settings}: ${g.knots} knots, ${g.agree} of ${g.compared} with two converged starts ` +
             `or more within 0.1%; the catalogue's start more than 0.1% above the lowest in ${g.catTrapped}`);
-    // the daemon's figures of every slice run (daemon.tsv: wall seconds,
-    // jobs ended, workers' busy seconds, workers, from its /metrics)
-    const runs = readdirSync(resultsRoot).map((dir) => join(resultsRoot, dir, 'daemon.tsv')).filter(existsSync)
-        .flatMap((path) => readFileSync(path, 'utf8').trim().split('\n').map((l) => l.split('\t').map(Number)));
-    if (runs.length) {
+    // the daemon's figures of every slice run (DAEMON_LOG: slice, wall
+    // seconds, jobs ended, workers' busy seconds, workers, from its /metrics)
+    if (existsSync(DAEMON_LOG)) {
+        const runs = readFileSync(DAEMON_LOG, 'utf8').trim().split('\n').slice(1)
+            .map((l) => l.split('\t').slice(1).map(Number));
         const [wall, ended, busy, slots] = runs.reduce((t, r) => [t[0] + r[0], t[1] + r[1], t[2] + r[2], t[3] + r[0] * r[3]], [0, 0, 0, 0]);
-        console.log(`  the daemon, over ${runs.length} slice runs with its figures: ${ended} jobs in ${(wall / 3600).toFixed(2)} h ` +
-            `(${(ended / (wall / 3600)).toFixed(1)} jobs an hour), workers busy ${(100 * busy / slots).toFixed(1)}% of the time`);
+        if (runs.length)
+            console.log(`  the daemon, over ${runs.length} slice runs in ${DAEMON_LOG}: ${ended} jobs in ${(wall / 3600).toFixed(2)} h ` +
+                `(${(ended / (wall / 3600)).toFixed(1)} jobs an hour), workers busy ${(100 * busy / slots).toFixed(1)}% of the time`);
     }
     const widest = summary.spreads.sort((a, b) => b[0] - a[0]).slice(0, 10).filter((s) => s[0] > 0.1);
     for (const [spread, knot, lo, lov, hi, hiv] of widest)
         console.log(`  ${knot}: ${spread.toFixed(3)}% apart (${lo} ${lov.toFixed(4)}, ${hi} ${hiv.toFixed(4)})`);
-    for (const f of summary.failed) console.log(`  failed: ${f}`);
+    console.log(`  failed starts: ${summary.failed}` + (failedStates.length ? ` (of the results here: ${failedStates.join('; ')})` : ''));
     console.log(`  type at the end: ${summary.changed.length ? `another's (left out of the lowest) in ${summary.changed.join(', ')}`
         : 'the file\'s in every result'}`);
 }
@@ -438,7 +475,8 @@ if (!opt.tableOnly) {
     const ended = await metric('jobs_ended_total') - before.ended;
     const busy = await metric('worker_busy_seconds_total') - before.busy;
     if (Number.isFinite(ended) && Number.isFinite(busy)) {
-        writeFileSync(join(resultsDir, 'daemon.tsv'), `${wall}\t${ended}\t${busy}\t${workers}\n`, { flag: 'a' });
+        if (!existsSync(DAEMON_LOG)) writeFileSync(DAEMON_LOG, 'run\twall.s\tjobs.ended\tbusy.s\tworkers\n');
+        writeFileSync(DAEMON_LOG, `${basename(resultsDir)}\t${wall.toFixed(0)}\t${ended}\t${busy.toFixed(0)}\t${workers}\n`, { flag: 'a' });
         console.log(`bench/catalogue: ${ended} jobs ended in ${wall.toFixed(0)} s (${(ended / (wall / 3600)).toFixed(1)} an hour), ` +
             `the ${workers} workers busy ${(100 * busy / (workers * wall)).toFixed(1)}% of the time (/metrics)`);
     }
