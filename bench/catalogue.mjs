@@ -26,7 +26,12 @@
 // It resumes: run again, it submits only the starts without a result
 // (the client's own resume); its daemon's store keeps the jobs of a run
 // that was stopped, which the next run's daemon takes up again.  A slice
-// K/N takes every N-th knot from the K-th, so the table fills over runs.
+// K/N takes every N-th knot from the K-th, so the table fills over runs;
+// a knot without results in OUT keeps its row of the table as it was
+// (the tightened curves are not committed, the table is), so a clean
+// clone goes on filling it.  Each slice run's daemon figures (jobs
+// ended, the workers' busy seconds, from /metrics) are added to
+// TABLE-daemon.tsv beside it.
 // Prints figures; never fails on time.
 //
 // usage: node bench/catalogue.mjs [options] [CATALOGUE_DIR]
@@ -47,7 +52,8 @@
 //   --engine ID       the engine's name in the settings column (default: the
 //                     last commit that changed engine/ or include/tk/)
 //   --out DIR         work directory (default build/catalogue)
-//   --table FILE      the table (default docs/catalogue.tsv)
+//   --table FILE      the table (default docs/catalogue.tsv; the daemon's figures
+//                     go to FILE without .tsv, then -daemon.tsv)
 //   --build DIR       the programs (default build)
 //   --only NAME,...   these knots only (a check of a few)
 //   --table-only      write the table and summary from OUT, submit nothing
