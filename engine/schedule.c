@@ -811,6 +811,13 @@ int tk_schedule_before_step(tk_run *r, tk_error *err)
         r->schedule.resolved_at = rope;
         return TK_OK;
     }
+    /* Right after a restart the last report is still the replaced
+     * curve's, and so is `rope`: a loose try, whose own count is reckoned
+     * from its own looser curve (go_loose), is brought at its first step
+     * to the count of the curve it replaced, where that keeps the type.
+     * That is how tries have run since 1e7a2b5, whose figures it made
+     * (10.34's turned try "to 56 vertices in 2 s": 0.625 a unit of the
+     * 89.14 it replaced). */
     double want = (double)level_count(r, rope);
     if (!(rope < r->schedule.resolved_at * (1.0 - fraction)) ||
         !(want < (double)r->shared.curve->nvert * (1.0 - fraction)))
@@ -818,11 +825,16 @@ int tk_schedule_before_step(tk_run *r, tk_error *err)
     /* so few vertices can lose the type (a wandered start of catalogue
      * 9.45, on a loose try's level at 47 vertices, failed its job that
      * way): where they would, the polygon stays, until the ropelength
-     * has fallen by as much again */
+     * has fallen by as much again.  Refused at a try's first step, its
+     * polygon goes on from its own ropelength (which restart() kept), not
+     * the replaced curve's: from that, 9.45's explored try (ropelength 261
+     * on 196 vertices) never came down to the next level's count and
+     * crawled on its loosest level for 6,500 steps. */
     bool kept = false;
     rc = resampled_keeps(r, r->shared.curve, (size_t)want, &kept, err);
     if (rc || !kept) {
-        r->schedule.resolved_at = rope;
+        if (r->life.nhistory > r->schedule.resampled_from)
+            r->schedule.resolved_at = rope;
         return rc;
     }
     return resample_to(r, (size_t)want, err);

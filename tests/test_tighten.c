@@ -15,6 +15,8 @@
 #include "support.h"
 #include "tk/curve.h"
 #include "tk/generate.h"
+#include "tk/invariants.h"
+#include "tk/relax.h"
 #include "tk/thickness.h"
 #include "tk/record.h"
 #include "tk/tighten.h"
@@ -2060,6 +2062,74 @@ START_TEST(a_loose_coarse_level_follows_the_ropelength)
 }
 END_TEST
 
+/* A loose polygon follows the ropelength down only where the fewer
+ * vertices keep the type (tk_schedule_before_step): a far start of
+ * catalogue 9.45 (wandered as `tightknot generate wander 9.45.vect 1`
+ * makes it), at resolution 5 with two loose levels, starts its first
+ * explored try at step 3,968, a turned curve of ropelength 261 on a loose
+ * level of 196 vertices.  That step's check reads the ropelength of the
+ * last report, the curve the try replaced (74.93), which calls for 47
+ * vertices; the try's curve resampled to 47 is another knot, and the run
+ * failed there (the type check after the resampling) before the guard.
+ * Refused there, the try's level follows its own ropelength down: it has
+ * fewer vertices than it started with before step 4,500 (judged from the
+ * replaced curve's ropelength, the level stayed at 196 for 6,500 steps).
+ * Every step is taken, each polygon of the start's type (the run checks
+ * every resampling), and the curve at the end is of the start's type by
+ * the invariants computed here. */
+START_TEST(a_loose_level_keeps_its_polygon_where_fewer_vertices_lose_the_type)
+{
+    const char *name = "a_loose_level_keeps_its_polygon_where_fewer_vertices_lose_the_type";
+    if ((quick() && tkt_skip(name, LONG_RUN)) ||
+        (!tkt_catalogue_dir() && tkt_skip(name, "no catalogue")))
+        return;
+    tk_curve *file = tkt_catalogue_curve("9.45.vect"), *c = NULL;
+    ck_assert_ptr_nonnull(file);
+    ck_assert_int_eq(tk_relax_wander(file, 1, 2000, &c, NULL), TK_OK);
+    tk_invariants type = TK_INVARIANTS_INIT, result = TK_INVARIANTS_INIT;
+    ck_assert_int_eq(tk_invariants_compute(c, &type, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 5;
+    o.loose = 2;
+    o.max_steps = 30000;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    size_t first = 0, least = SIZE_MAX;
+    double replaced = NAN, from = NAN;
+    while (tk_run_latest(run)->step < 4500) {
+        double before = tk_run_latest(run)->ropelength;
+        ck_assert_msg(tk_run_step(run, &err) == TK_OK, "step %ld: %s", tk_run_latest(run)->step,
+                      err.message);
+        const tk_step_report *s = tk_run_latest(run);
+        if (s->restarts != 1)
+            continue;
+        /* the first try, on its first polygon and those it came down to */
+        if (!first) {
+            first = s->vertices;
+            replaced = before;
+            from = s->ropelength;
+        }
+        least = s->vertices < least ? s->vertices : least;
+    }
+    printf("9.45 wandered: its first try from %.2f (replacing %.2f) on %zu vertices, down to %zu "
+           "by step %ld at %.4f\n", from, replaced, first, least, tk_run_latest(run)->step,
+           tk_run_latest(run)->ropelength);
+    ck_assert_uint_gt(first, 0);
+    /* a try far looser than the curve it replaced, which came down */
+    ck_assert_double_gt(from, 3.0 * replaced);
+    ck_assert_uint_lt(least, first);
+    ck_assert_int_eq(tk_invariants_compute(tk_run_curve(run), &result, NULL), TK_OK);
+    ck_assert_int_eq(tk_invariants_compare(&type, &result, NULL), TK_OK);
+    tk_invariants_free(&result);
+    tk_invariants_free(&type);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+    tk_curve_free(&file);
+}
+END_TEST
+
 /* The fall of tk_history_fall (run.h), recomputed: the least ropelength
  * of the last `window` reports up to (not including) report `n` against
  * the least of the `window` before them (fewer when the level is
@@ -2754,6 +2824,7 @@ int main(void)
     tcase_add_test(tc, a_loose_start_keeps_its_final_count_through_escapes);
     tcase_add_test(tc, loose_levels_come_first_for_every_loose_try);
     tcase_add_test(tc, a_loose_coarse_level_follows_the_ropelength);
+    tcase_add_test(tc, a_loose_level_keeps_its_polygon_where_fewer_vertices_lose_the_type);
     tcase_add_test(tc, a_loose_start_at_a_vertex_count_escapes_coarse);
     tcase_add_test(tc, a_fine_coarse_level_waits_as_many_more_steps);
     tcase_add_test(tc, the_coarsest_level_of_a_try_is_polished_first);
