@@ -65,7 +65,7 @@ describe('F2: a pause of the store does not spend the time budget', { skip: moun
             await sleep(PAUSE * 1000);
             rmSync(join(storeDir, 'filler'));
             const freedAfter = (Date.now() - pausedAt) / 1000;
-            const done = await waitFinal(d, job.id, { timeout: 60000 });
+            const done = await waitFinal(d, job.id);
             const wall = (Date.parse(done.finished) - Date.parse(done.started)) / 1000;
             t.diagnostic(`paused at step ${paused.progress.step} (${paused.seconds} s of work) for ${freedAfter.toFixed(1)} s; ` +
                 `ended ${done.state}/${done.stop_reason} at step ${done.progress.step}, seconds ${done.seconds}, ` +

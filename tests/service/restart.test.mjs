@@ -164,7 +164,7 @@ describe('SIGTERM with a running job, and restart', () => {
             assert.ok(stored.progress.step > 0 && stored.progress.step < STEPS,
                 `stored at step ${stored.progress.step}`);
             assert.equal(stored.finished, null);
-            const done = await waitFinal(d2, a.id, { timeout: 60000 });
+            const done = await waitFinal(d2, a.id);
             t.diagnostic(`stopped at step ${stored.progress.step}, finished at ${done.progress.step}`);
             assert.equal(done.state, 'done', JSON.stringify(done));
             assert.equal(done.stop_reason, 'steps');

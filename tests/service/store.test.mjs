@@ -79,7 +79,7 @@ describe('a full file system under the store', { skip }, () => {
         assert.equal((await d.get(`/v1/jobs/${job.id}/history`)).status, 200);
 
         rmSync(join(dir, 'filler'));
-        const done = await waitFinal(d, job.id, { timeout: 60000 });
+        const done = await waitFinal(d, job.id);
         assert.equal(done.state, 'done', JSON.stringify(done));
         assert.equal(done.error, null);
         assert.equal(done.stop_reason, 'time');
@@ -99,7 +99,7 @@ describe('a full file system under the store', { skip }, () => {
         await d.stop();
         rmSync(join(dir, 'filler'));
         d = await startDaemon({ workers: 1, db: join(dir, 'jobs.db') });
-        const done = await waitFinal(d, job.id, { timeout: 60000 });
+        const done = await waitFinal(d, job.id);
         assert.equal(done.state, 'done', JSON.stringify(done));
         assert.equal(done.stop_reason, 'time');
     });

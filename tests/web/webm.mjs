@@ -58,8 +58,10 @@ export function readWebm(bytes) {
 // WebM with a video frame for each film frame, or two where drawing one
 // took longer than a sample's time (the stream samples the canvas `fps`
 // times a second; each frame stays on it that long once shown), over at
-// least 0.9 of the nominal time (the recorder stamps frames in real time:
-// a loaded machine may space them wider, up to 4 times here).
+// least 0.9 of the nominal time: no frame is shown for less than its
+// 1/fps.  There is no upper bound: the recorder stamps frames in real
+// time, and a loaded machine spaces them wider (7.9 s for 1.2 s nominal
+// beside the thread sanitizer's suite), which says nothing of the page.
 export function assertFilm(bytes, count, fps, what) {
     const webm = readWebm(bytes);
     console.log(`${what}: ${webm.frames} video frames over ${webm.durationMs} ms for ${count} film frames`);
@@ -67,6 +69,6 @@ export function assertFilm(bytes, count, fps, what) {
     assert.ok(webm.frames >= 0.9 * count && webm.frames <= 2.5 * count,
         `${webm.frames} video frames for ${count} film frames`);
     const nominal = (count - 1) * 1000 / fps;
-    assert.ok(webm.durationMs >= 0.9 * nominal && webm.durationMs <= 4 * nominal,
+    assert.ok(webm.durationMs >= 0.9 * nominal,
         `${webm.durationMs} ms for ${count} frames at ${fps} a second (${nominal} ms)`);
 }
