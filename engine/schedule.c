@@ -623,8 +623,7 @@ static int restart(tk_run *r, tk_curve *curve, size_t count, int polish, tk_erro
      * turned try of catalogue 10.34 (resolution 5), autoscaled far
      * looser than the best curve it came from (89.14), stayed on its
      * 164-vertex loose level for 10 s, still at 101.7, as its ropelength
-     * had to fall below three quarters of 89.14 first; following its own
-     * down (to 56 vertices in 2 s) the run ended at 88.28, not 88.84 */
+     * had to fall below three quarters of 89.14 first */
     r->schedule.resolved_at = m.ropelength;
     tk_stepping_reset(r);
     return resampled ? TK_OK : tk_type_check(r, "an escape's deformation", err);
@@ -812,12 +811,23 @@ int tk_schedule_before_step(tk_run *r, tk_error *err)
         return TK_OK;
     }
     /* Right after a restart the last report is still the replaced
-     * curve's, and so is `rope`: a loose try, whose own count is reckoned
-     * from its own looser curve (go_loose), is brought at its first step
-     * to the count of the curve it replaced, where that keeps the type.
-     * That is how tries have run since 1e7a2b5, whose figures it made
-     * (10.34's turned try "to 56 vertices in 2 s": 0.625 a unit of the
-     * 89.14 it replaced). */
+     * curve's, and so is `rope`: a try's first step is not judged here.
+     * A loose try stays on the count go_loose reckoned from its own
+     * looser curve and follows its own ropelength down from there
+     * (restart() stored it as resolved_at).  Until this was so, the
+     * check brought each loose try at its first step to the count of the
+     * curve it replaced (10.34's turned try "to 56 vertices in 2 s" in
+     * 1e7a2b5's figures: 0.625 a unit of the 89.14 it replaced), as
+     * coarse a polygon as the tightened curve's for a curve loosened many
+     * times over; its tightening then fell back into the basin it had
+     * left more often.  Measured at resolution 5, 60 s (bench/FIGURES.md,
+     * "A loose try on its own count"): of the catalogue files of 38
+     * knots, 7 ended lower, by 0.06% to 4.2%, 2 higher, by 0.08% and
+     * 1.3%; of the 27 starts of a table slice, 2 lower (0.21%, 0.47%), 1
+     * higher (0.11%); the catalogue's 10.124 in 120 s reaches T(3,5)'s
+     * basin (71.0022; 71.0547 before). */
+    if (r->life.nhistory == r->schedule.resampled_from)
+        return TK_OK;
     double want = (double)level_count(r, rope);
     if (!(rope < r->schedule.resolved_at * (1.0 - fraction)) ||
         !(want < (double)r->shared.curve->nvert * (1.0 - fraction)))
@@ -825,16 +835,11 @@ int tk_schedule_before_step(tk_run *r, tk_error *err)
     /* so few vertices can lose the type (a wandered start of catalogue
      * 9.45, on a loose try's level at 47 vertices, failed its job that
      * way): where they would, the polygon stays, until the ropelength
-     * has fallen by as much again.  Refused at a try's first step, its
-     * polygon goes on from its own ropelength (which restart() kept), not
-     * the replaced curve's: from that, 9.45's explored try (ropelength 261
-     * on 196 vertices) never came down to the next level's count and
-     * crawled on its loosest level for 6,500 steps. */
+     * has fallen by as much again. */
     bool kept = false;
     rc = resampled_keeps(r, r->shared.curve, (size_t)want, &kept, err);
     if (rc || !kept) {
-        if (r->life.nhistory > r->schedule.resampled_from)
-            r->schedule.resolved_at = rope;
+        r->schedule.resolved_at = rope;
         return rc;
     }
     return resample_to(r, (size_t)want, err);
