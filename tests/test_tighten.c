@@ -2068,6 +2068,34 @@ START_TEST(a_loose_coarse_level_follows_the_ropelength)
 }
 END_TEST
 
+/* A run of c at resolution 5 with two loose levels for `steps` steps;
+ * *type gets c's invariants, for loose_run_end. */
+static tk_run *loose_run(const tk_curve *c, long steps, tk_invariants *type)
+{
+    ck_assert_int_eq(tk_invariants_compute(c, type, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 5;
+    o.loose = 2;
+    o.max_steps = steps;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    return run;
+}
+
+/* The run's curve is of the start's type (by the invariants computed
+ * here); frees the run and the type. */
+static void loose_run_end(tk_run **run, tk_invariants *type)
+{
+    tk_invariants result = TK_INVARIANTS_INIT;
+    ck_assert_int_eq(tk_invariants_compute(tk_run_curve(*run), &result, NULL), TK_OK);
+    ck_assert_int_eq(tk_invariants_compare(type, &result, NULL), TK_OK);
+    tk_invariants_free(&result);
+    tk_invariants_free(type);
+    tk_run_free(run);
+}
+
 /* A loose polygon follows the ropelength down only where the fewer
  * vertices keep the type (tk_schedule_before_step): a far start of
  * catalogue 9.45 (wandered as `tightknot generate wander 9.45.vect 1`
@@ -2093,16 +2121,9 @@ START_TEST(a_loose_level_keeps_its_polygon_where_fewer_vertices_lose_the_type)
     tk_curve *file = tkt_catalogue_curve("9.45.vect"), *c = NULL;
     ck_assert_ptr_nonnull(file);
     ck_assert_int_eq(tk_relax_wander(file, 1, 2000, &c, NULL), TK_OK);
-    tk_invariants type = TK_INVARIANTS_INIT, result = TK_INVARIANTS_INIT;
-    ck_assert_int_eq(tk_invariants_compute(c, &type, NULL), TK_OK);
-    tk_options o = TK_OPTIONS_INIT;
-    o.autoscale = true;
-    o.resolution = 5;
-    o.loose = 2;
-    o.max_steps = 30000;
-    tk_run *run = NULL;
+    tk_invariants type = TK_INVARIANTS_INIT;
+    tk_run *run = loose_run(c, 30000, &type);
     tk_error err;
-    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
     size_t first = 0, least = SIZE_MAX;
     double replaced = NAN, from = NAN;
     while (tk_run_latest(run)->step < 4500) {
@@ -2127,11 +2148,7 @@ START_TEST(a_loose_level_keeps_its_polygon_where_fewer_vertices_lose_the_type)
     /* a try far looser than the curve it replaced, which came down */
     ck_assert_double_gt(from, 3.0 * replaced);
     ck_assert_uint_lt(least, first);
-    ck_assert_int_eq(tk_invariants_compute(tk_run_curve(run), &result, NULL), TK_OK);
-    ck_assert_int_eq(tk_invariants_compare(&type, &result, NULL), TK_OK);
-    tk_invariants_free(&result);
-    tk_invariants_free(&type);
-    tk_run_free(&run);
+    loose_run_end(&run, &type);
     tk_curve_free(&c);
     tk_curve_free(&file);
 }
@@ -2158,16 +2175,9 @@ START_TEST(a_loose_try_starts_on_its_own_count)
         return;
     tk_curve *c = tkt_catalogue_curve("2.2.1.vect");
     ck_assert_ptr_nonnull(c);
-    tk_invariants type = TK_INVARIANTS_INIT, result = TK_INVARIANTS_INIT;
-    ck_assert_int_eq(tk_invariants_compute(c, &type, NULL), TK_OK);
-    tk_options o = TK_OPTIONS_INIT;
-    o.autoscale = true;
-    o.resolution = 5;
-    o.loose = 2;
-    o.max_steps = 6000;
-    tk_run *run = NULL;
+    tk_invariants type = TK_INVARIANTS_INIT;
+    tk_run *run = loose_run(c, 6000, &type);
     tk_error err;
-    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
     long restarts = 0;
     int far = 0;
     while (tk_run_latest(run)->step < 2500) {
@@ -2187,11 +2197,7 @@ START_TEST(a_loose_try_starts_on_its_own_count)
         ck_assert_uint_gt(s->vertices, 2 * replaced);
     }
     ck_assert_int_ge(far, 1);
-    ck_assert_int_eq(tk_invariants_compute(tk_run_curve(run), &result, NULL), TK_OK);
-    ck_assert_int_eq(tk_invariants_compare(&type, &result, NULL), TK_OK);
-    tk_invariants_free(&result);
-    tk_invariants_free(&type);
-    tk_run_free(&run);
+    loose_run_end(&run, &type);
     tk_curve_free(&c);
 }
 END_TEST
