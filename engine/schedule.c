@@ -819,13 +819,12 @@ int tk_schedule_before_step(tk_run *r, tk_error *err)
      * curve it replaced (10.34's turned try "to 56 vertices in 2 s" in
      * 1e7a2b5's figures: 0.625 a unit of the 89.14 it replaced), as
      * coarse a polygon as the tightened curve's for a curve loosened many
-     * times over; its tightening then fell back into the basin it had
-     * left more often.  Measured at resolution 5, 60 s (bench/FIGURES.md,
+     * times over.  Measured at resolution 5, 60 s (bench/FIGURES.md,
      * "A loose try on its own count"): of the catalogue files of 38
      * knots, 7 ended lower, by 0.06% to 4.2%, 2 higher, by 0.08% and
-     * 1.3%; of the 27 starts of a table slice, 2 lower (0.21%, 0.47%), 1
-     * higher (0.11%); the catalogue's 10.124 in 120 s reaches T(3,5)'s
-     * basin (71.0022; 71.0547 before). */
+     * 1.3%; of the 54 starts of two table slices, 3 lower (0.21% to 2.5%),
+     * 4 higher (0.11% to 4.6%): a reshuffle; the catalogue's 10.124 in
+     * 120 s reaches T(3,5)'s basin (71.0022; 71.0547 before). */
     if (r->life.nhistory == r->schedule.resampled_from)
         return TK_OK;
     double want = (double)level_count(r, rope);
