@@ -811,8 +811,10 @@ int tk_schedule_before_step(tk_run *r, tk_error *err)
         return TK_OK;
     }
     /* Right after a restart the last report is still the replaced
-     * curve's, and so is `rope`: a try's first step is not judged here.
-     * A loose try stays on the count go_loose reckoned from its own
+     * curve's, and so is `rope`: a polygon with no report of its own is
+     * not judged here (after a refinement the two agree anyway, as
+     * resample_to stores that ropelength).  So a loose try stays on the
+     * count go_loose reckoned from its own
      * looser curve and follows its own ropelength down from there
      * (restart() stored it as resolved_at).  Until this was so, the
      * check brought each loose try at its first step to the count of the

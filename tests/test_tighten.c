@@ -1859,12 +1859,12 @@ static void loose_start_escapes(int loose, long steps)
              * or a loose level of at least that reference */
             ck_assert_int_eq(e[k].turned, kind == 0);
             if (loosened) {
-                /* on a loose level of its own curve: coarser than the
+                /* on a loose level of its own curve: at most half the
                  * coarse level's 2.5 a unit of its own ropelength (a far
                  * try, several times the reference, can have more
                  * vertices than the reference's coarse polygon) */
                 ck_assert_uint_ge(h[i].vertices, (size_t)ceil(ldexp(2.5, -loose) * reference));
-                ck_assert_uint_lt(h[i].vertices, (size_t)ceil(2.5 * h[i].ropelength));
+                ck_assert_uint_le(h[i].vertices, (size_t)ceil(ldexp(2.5, 1 - loose) * h[i].ropelength));
             } else {
                 ck_assert_uint_eq(h[i].vertices, again);
             }
