@@ -462,6 +462,52 @@ START_TEST(coarse_to_fine_ends_at_the_resolution)
 }
 END_TEST
 
+/* Two unlinked rings a hundred radii apart, each a regular 15-gon: an
+ * odd regular polygon has no doubly critical pair of its own (no two
+ * edges face each other), so the shortest self-distance is the gap, and
+ * twice the length over it reckons a ropelength of 0.25, where each ring
+ * alone is 2 pi at least (Fenchel's theorem).  The run still ends at
+ * resolution 5 of the tight value (ceil(5 * 4 pi) = 63 vertices), two
+ * regular polygons of about 32 vertices: 2 n tan(pi / n) each (a
+ * resolution reckoned from the gap ended on two triangles, 12 sqrt(3) =
+ * 20.78; catalogue 0.2.1 turned inside out on 23 vertices, 12.89). */
+START_TEST(rings_far_apart_get_the_resolution_s_vertices)
+{
+    size_t counts[2] = {15, 15};
+    bool closed[2] = {true, true};
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_curve_new(&c, 2, counts, closed, NULL), TK_OK);
+    for (size_t comp = 0; comp < 2; comp++)
+        for (size_t i = 0; i < 15; i++) {
+            double *p = tk_curve_vertex(c, c->offset[comp] + i), a = 2.0 * M_PI * i / 15;
+            p[0] = 100.0 * comp + cos(a);
+            p[1] = comp ? 0.0 : sin(a);
+            p[2] = comp ? sin(a) : 0.0;
+        }
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 5;
+    o.escapes = 0;
+    o.max_steps = 1500;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    tk_stop_reason why;
+    const tk_step_report *last = run_watched(run, &o, "two rings far apart", &why);
+    size_t n = last->vertices, half = n / 2;
+    double polygons = 2.0 * (double)half * tan(M_PI / (double)half) +
+                      2.0 * (double)(n - half) * tan(M_PI / (double)(n - half));
+    printf("two rings far apart: %zu vertices, ropelength %.6f (two regular polygons "
+           "of %zu and %zu: %.6f)\n",
+           n, last->ropelength, half, n - half, polygons);
+    ck_assert_uint_ge(n, (size_t)ceil(5.0 * 4.0 * M_PI));
+    ck_assert_msg(last->ropelength <= 1.001 * polygons, "%.6f against %.6f", last->ropelength,
+                  polygons);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 /* Tightens the catalogue's 3.1 at resolution 5 for `steps` steps; false
  * (the run skipped, saying why) in the quick form or without the
  * catalogue. */
@@ -2880,6 +2926,7 @@ int main(void)
     tcase_add_test(tc, the_defaults_tighten_the_figure_eight);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);
     tcase_add_test(tc, coarse_to_fine_ends_at_the_resolution);
+    tcase_add_test(tc, rings_far_apart_get_the_resolution_s_vertices);
     tcase_add_test(tc, vertices_option_ends_at_exactly_that_count);
     tcase_add_test(tc, cancellation_stops_within_one_step);
     tcase_add_test(tc, parallel_runs_equal_serial_runs);
