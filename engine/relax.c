@@ -10,6 +10,7 @@
 #include "tk/generate.h"
 #include "tk/invariants.h"
 #include "tk/isotopy.h"
+#include "tk/thickness.h"
 
 /* The springs' weight against the repulsion: at 1 the repulsion pulls
  * edges out to twice the mean (catalogue 10.124 relaxed: edges 1.09 to
@@ -32,6 +33,15 @@
 #define TURN_CLEARANCE 1e-3
 #define TURN_OFFSET 0.15
 #define TURN_DOUBLINGS 3
+/* A turned curve more than TURN_LOOSEST times the start's ropelength is
+ * refused.  Inversion shrinks what lies far from the centre by the square
+ * of its distance: a link's component far out comes back a speck on a
+ * vertex or three (catalogue 0.3.1's three rings, tight at 18.91 on 95
+ * vertices, turned about a point near one ring: ropelength 1.2e13, a
+ * ring 1.5e-12 thick for 9.2 of length), and its try asked for 1.4e13
+ * vertices.  Turns of tight curves that keep their components' sizes come
+ * 1.07 to 3 times as long (10.34, 6.2.3, 9.3.12, 10.124, 0.3.1). */
+#define TURN_LOOSEST 20.0
 /* Wandering: the target is the curve displaced by WANDER_MODES Fourier
  * modes of amplitude its components' mean radius (L / 2 pi), the pull's
  * weight WANDER_PULL. */
@@ -305,6 +315,15 @@ int tk_relax_turn(const tk_curve *c, const double offset[3], size_t vertices, in
     if (!rc && !kept)
         rc = tk_error_set(err, TK_ENUMERIC, "turned inside out, the curve could not keep "
                           "its type on up to %zu vertices", vertices / 2);
+    tk_measure before, after;
+    if (!rc)
+        rc = tk_thickness_measure(c, NULL, &before, err);
+    if (!rc)
+        rc = tk_thickness_measure(*out, NULL, &after, err);
+    if (!rc && !(after.ropelength <= TURN_LOOSEST * before.ropelength))
+        rc = tk_error_set(err, TK_ENUMERIC, "turned inside out, the curve's ropelength is "
+                          "%.3g, %.3g times its own: a strand far from the centre shrank to "
+                          "a speck", after.ropelength, after.ropelength / before.ropelength);
     if (rc)
         tk_curve_free(out);
     tk_invariants_free(&type);

@@ -17,6 +17,7 @@
 #include "tk/generate.h"
 #include "tk/invariants.h"
 #include "tk/relax.h"
+#include "tk/thickness.h"
 
 /* A two-component link, disguised: uneven edges and no symmetry, so that
  * every term of the gradient (springs of two lengths, the pull) counts. */
@@ -262,6 +263,54 @@ START_TEST(turning_keeps_type_and_hand)
 }
 END_TEST
 
+/* Three round rings in a row, unlinked, the last far out: turned about
+ * the first one's centre, the far ring comes back a speck (inversion
+ * shrinks by the square of the distance), and the turn is refused for it
+ * (the curve's ropelength would be hundreds of times its own); turned
+ * about the centroid every ring keeps a size, and the result is taken
+ * with a ropelength within 20 times the rings'. */
+START_TEST(turning_refuses_a_ring_shrunk_to_a_speck)
+{
+    size_t counts[3] = {24, 24, 24};
+    bool closed[3] = {true, true, true};
+    double at[3] = {0.0, 4.0, 40.0};
+    tk_curve *rings = NULL, *out = NULL;
+    ck_assert_int_eq(tk_curve_new(&rings, 3, counts, closed, NULL), TK_OK);
+    for (size_t comp = 0; comp < 3; comp++)
+        for (size_t i = 0; i < 24; i++) {
+            double *p = tk_curve_vertex(rings, rings->offset[comp] + i), a = 2.0 * M_PI * i / 24;
+            p[0] = at[comp] + cos(a);
+            p[1] = sin(a);
+            p[2] = 0.0;
+        }
+    double centroid[3] = {0.0, 0.0, 0.0}, spread = 0.0;
+    for (size_t v = 0; v < rings->nvert; v++)
+        for (int k = 0; k < 3; k++)
+            centroid[k] += rings->xyz[3 * v + k] / (double)rings->nvert;
+    for (size_t v = 0; v < rings->nvert; v++)
+        for (int k = 0; k < 3; k++)
+            spread += pow(rings->xyz[3 * v + k] - centroid[k], 2) / (double)rings->nvert;
+    spread = sqrt(spread);
+    tk_measure m, turned;
+    ck_assert_int_eq(tk_thickness_measure(rings, NULL, &m, NULL), TK_OK);
+    double first[3] = {-centroid[0] / spread, -centroid[1] / spread, -centroid[2] / spread};
+    tk_error err;
+    ck_assert_int_eq(tk_relax_turn(rings, first, 36, 50, &out, &err), TK_ENUMERIC);
+    ck_assert_ptr_null(out);
+    printf("turned about the first ring: %s\n", err.message);
+    ck_assert_ptr_nonnull(strstr(err.message, "speck"));
+    double zero[3] = {0.0, 0.0, 0.0};
+    ck_assert_int_eq(tk_relax_turn(rings, zero, 36, 50, &out, NULL), TK_OK);
+    check_kept(rings, out);
+    ck_assert_int_eq(tk_thickness_measure(out, NULL, &turned, NULL), TK_OK);
+    printf("turned about the centroid: ropelength %.4g from %.4g\n", turned.ropelength,
+           m.ropelength);
+    ck_assert(turned.ropelength <= 20.0 * m.ropelength);
+    tk_curve_free(&out);
+    tk_curve_free(&rings);
+}
+END_TEST
+
 /* Wandering: the type kept, the shape far from the start (some vertex
  * moved by more than the curve's radius), the same seed the same curve. */
 START_TEST(wandering_goes_far_and_keeps_the_type)
@@ -314,6 +363,7 @@ int main(void)
     tcase_add_test(tc, a_pull_cannot_change_the_type);
     tcase_add_test(tc, a_round_circle_stays);
     tcase_add_test(tc, turning_keeps_type_and_hand);
+    tcase_add_test(tc, turning_refuses_a_ring_shrunk_to_a_speck);
     tcase_add_test(tc, wandering_goes_far_and_keeps_the_type);
     tcase_add_test(tc, invalid_arguments);
     suite_add_tcase(s, tc);

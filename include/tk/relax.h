@@ -74,7 +74,9 @@ int tk_relax(const tk_curve *c, const tk_curve *target, double pull, int iterati
  * count doubles (twice at most; the result can have 4 x `vertices`), and
  * the result's Alexander polynomials and linking numbers are checked
  * too.  TK_ENUMERIC when the centre lies within 1e-3 of the spread from
- * the curve, or the type could not be kept. */
+ * the curve, the type could not be kept, or the result's ropelength is
+ * more than 20 times the curve's (a component far from the centre
+ * shrinks by the square of its distance). */
 int tk_relax_turn(const tk_curve *c, const double offset[3], size_t vertices, int steps,
                   tk_curve **out, tk_error *err);
 
