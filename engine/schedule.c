@@ -167,11 +167,14 @@ static int measure(const tk_curve *c, tk_measure *m, tk_error *err)
  *
  * Never below what every closed component costs: a closed curve turns
  * by 2 pi at least (Fenchel), and a tube of radius r turns by at most
- * 1/r a unit of length, so each is 2 pi radii long at least.  Rings far
- * apart have a self-distance as large as the link, which alone reckoned
- * an unlink of two rings turned inside out at 4.5 (tight: 4 pi), and its
- * run ended on 23 vertices at resolution 5, not 64 (12.89 against the
- * catalogue file's 12.61), three rings on 18 (20.78 against 18.92). */
+ * 1/r a unit of length, so each is 2 pi radii long at least.  A ring
+ * drawn as an odd polygon has no doubly critical pair of its own (no two
+ * of its edges face each other), so for rings apart the shortest
+ * self-distance is the gap between them: catalogue 0.2.1 (two unlinked
+ * rings) turned inside out, 43.4 apart for a length of 97.7, reckoned
+ * 4.51 (tight: 4 pi), and its run ended on 23 vertices at resolution 5,
+ * not 64 (12.89 against the catalogue file's 12.61); 0.3.1's on 18
+ * (three hexagons, 20.78 against 18.91). */
 static double reckoned_ropelength(const tk_curve *c, const tk_measure *m)
 {
     double rope = isfinite(m->shortest) && m->shortest > 0.0 ? 2.0 * m->length / m->shortest
