@@ -200,6 +200,21 @@ static double writhe(const tk_curve *c)
     return w / (4.0 * M_PI);
 }
 
+/* The centroid of c's vertices into centre, and their root mean square
+ * distance from it (near the wire's, which tk_relax_turn uses). */
+static double vertex_spread(const tk_curve *c, double centre[3])
+{
+    double spread = 0.0;
+    centre[0] = centre[1] = centre[2] = 0.0;
+    for (size_t i = 0; i < c->nvert; i++)
+        for (int k = 0; k < 3; k++)
+            centre[k] += c->xyz[3 * i + k] / (double)c->nvert;
+    for (size_t i = 0; i < c->nvert; i++)
+        for (int k = 0; k < 3; k++)
+            spread += pow(c->xyz[3 * i + k] - centre[k], 2) / (double)c->nvert;
+    return sqrt(spread);
+}
+
 /* Turned inside out, a trefoil stays a trefoil of the same hand (its
  * writhe keeps its sign: the mirror undoes the inversion's), a link keeps
  * its linking number.  A centre on the curve is refused, not followed
@@ -230,14 +245,7 @@ START_TEST(turning_keeps_type_and_hand)
     tk_curve_free(&knot);
     ck_assert_int_eq(tk_generate_torus(2, 5, 200, &knot, NULL), TK_OK);
     const double *v = tk_curve_vertex(knot, 0);
-    double centre[3] = {0.0, 0.0, 0.0}, spread = 0.0;
-    for (size_t i = 0; i < knot->nvert; i++)
-        for (int k = 0; k < 3; k++)
-            centre[k] += knot->xyz[3 * i + k] / (double)knot->nvert;
-    for (size_t i = 0; i < knot->nvert; i++)
-        for (int k = 0; k < 3; k++)
-            spread += pow(knot->xyz[3 * i + k] - centre[k], 2) / (double)knot->nvert;
-    spread = sqrt(spread);
+    double centre[3], spread = vertex_spread(knot, centre);
     int near = 0, turned = 0;
     for (int step = -20; step <= 20; step++) {
         double onto[3];
@@ -283,14 +291,7 @@ START_TEST(turning_refuses_a_ring_shrunk_to_a_speck)
             p[1] = sin(a);
             p[2] = 0.0;
         }
-    double centroid[3] = {0.0, 0.0, 0.0}, spread = 0.0;
-    for (size_t v = 0; v < rings->nvert; v++)
-        for (int k = 0; k < 3; k++)
-            centroid[k] += rings->xyz[3 * v + k] / (double)rings->nvert;
-    for (size_t v = 0; v < rings->nvert; v++)
-        for (int k = 0; k < 3; k++)
-            spread += pow(rings->xyz[3 * v + k] - centroid[k], 2) / (double)rings->nvert;
-    spread = sqrt(spread);
+    double centroid[3], spread = vertex_spread(rings, centroid);
     tk_measure m, turned;
     ck_assert_int_eq(tk_thickness_measure(rings, NULL, &m, NULL), TK_OK);
     double first[3] = {-centroid[0] / spread, -centroid[1] / spread, -centroid[2] / spread};
