@@ -274,7 +274,7 @@ END_TEST
 /* Three round rings in a row, unlinked, the last far out: turned about
  * the first one's centre, the far ring comes back a speck (inversion
  * shrinks by the square of the distance), and the turn is refused for it
- * (the curve's ropelength would be hundreds of times its own); turned
+ * (the curve's ropelength would be 1e8 times its own); turned
  * about the centroid every ring keeps a size, and the result is taken
  * with a ropelength within 20 times the rings'. */
 START_TEST(turning_refuses_a_ring_shrunk_to_a_speck)
