@@ -166,7 +166,7 @@ test('remote submit without a token, or with a wrong one, stops at the first 401
     const bare = await run(['submit', '--steps', '3', '--out', join(dir, 'out'), ...files]);
     assert.equal(bare.code, 3, bare.stderr);
     assert.match(bare.stderr, /needs a token \(401\): pass --token TOKEN or set \$TIGHTKNOT_TOKEN/);
-    assert.equal((bare.stderr.match(/401/g) || []).length, 1, `one refusal, not one per file: ${bare.stderr}`);
+    assert.equal((bare.stderr.match(/\(401\)/g) || []).length, 1, `one refusal, not one per file: ${bare.stderr}`);
     assert.doesNotMatch(bare.stderr, /refused:/, 'no file is marked refused');
     const wrong = await run(['--token', 'not-a-token-of-the-file', 'submit', '--steps', '3',
         '--out', join(dir, 'out2'), ...files]);
