@@ -87,8 +87,17 @@
  * reached, against 8, and their excess over it sums to 2.7%, against
  * 10.7% (bench/FIGURES.md; exploring for half the budget, escape.c). */
 #define JUDGED_SHARE 0.05
-/* Coarse to fine: the coarsest polygon has at least this many vertices
- * per unit ropelength, and at most this many halvings are undone. */
+/* Coarse to fine: the coarsest polygon is the halving of the final one
+ * nearest this many vertices per unit ropelength on a log scale (at
+ * least COARSEST_RESOLUTION / sqrt 2), and at most this many halvings are
+ * undone.  Resolution 5's coarsest polygon has 2.5 a unit, and the
+ * escapes judge their tries there (escape.c).  When the floor was 2.5
+ * itself, a vertex count of 4 to 5 a unit (the atlas's: 10_124 at 576
+ * is 8.1 a unit) stopped on a coarsest polygon of 4 to 5, where a try's
+ * basins lie closer together: catalogue 10.124 at 576 vertices (600 s
+ * of processor time, seed 1) ended at 71.02151, its fourteen tries
+ * never below 71.0239; with the coarsest polygon on 144 vertices, 2.03 a
+ * unit, it ended at 70.96826, T(3,5)'s basin (bench/FIGURES.md). */
 #define COARSEST_RESOLUTION 2.5
 #define MAX_COARSE_LEVELS 3
 /* Loose levels (the loose option): the first tightening starts that many
@@ -323,7 +332,7 @@ static int levels_below(const tk_run *r, double resolution)
 {
     const tk_options *o = &r->opt;
     if (resolution > 0.0 && o->coarse_to_fine && o->snapshot_every == 0)
-        return halvings(resolution, COARSEST_RESOLUTION, MAX_COARSE_LEVELS);
+        return halvings(resolution, COARSEST_RESOLUTION / M_SQRT2, MAX_COARSE_LEVELS);
     return 0;
 }
 
@@ -767,7 +776,8 @@ static void keep_at_tube(tk_run *r)
 }
 
 /* With the vertices option a start too loose for a coarse level (fewer
- * than 2 x COARSEST_RESOLUTION vertices per unit of its ropelength)
+ * than 2 x COARSEST_RESOLUTION / sqrt 2 vertices per unit of its
+ * ropelength)
  * starts on the final polygon, and gets the coarse levels its ropelength
  * allows once it has fallen that far, before the final polygon is first
  * reached.  Without them Lissajous 6_1 L(3,2,5) (ropelength 429) at 480

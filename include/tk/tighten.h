@@ -121,9 +121,9 @@
       "with a resolution: each time the ropelength has fallen by this fraction, resample "   \
       "to resolution x ropelength vertices again (0: never)")                                \
     X(coarse_to_fine, BOOL, true, 0, 1, "coarse",                                            \
-      "with a resolution: start with half the vertices (a quarter, ... while 2.5 per unit "  \
-      "ropelength remain), fewer each time the ropelength falls by a quarter, and double "   \
-      "them whenever it all but stops falling")                                              \
+      "with a resolution: start with half the vertices (a quarter, ... to the halving "     \
+      "nearest 2.5 per unit ropelength, at most an eighth), fewer each time the "            \
+      "ropelength falls by a quarter, and double them whenever it all but stops falling")    \
     X(loose, INT, 2, 0, 2, "loose",                                                          \
       "with a resolution: the first tightening starts this many halvings below the "        \
       "coarsest level, while 0.6 vertices a unit of ropelength remain, each left at its "    \
