@@ -185,7 +185,7 @@ START_TEST(generated_chain_of_three_tightens_to_12_pi_plus_4)
      * joined by straight pieces of length 1 (4 pi + 4).  The end rings
      * pull kinks into themselves where they hook the middle ring before
      * they round out, so this exercises the kink constraints.  On 300
-     * vertices, coarse to fine from 150: at 4 a unit of the tight
+     * vertices (a coarse level of 150, a loose one of 75): at 4 a unit of the tight
      * ropelength (168) the polygon itself is 0.1% longer (a ring of n
      * sides is 2 n tan(pi / n) for a smooth 2 pi: 0.13% for n = 50). */
     tk_curve *c = NULL;
