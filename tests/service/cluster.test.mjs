@@ -20,9 +20,10 @@ describe('three daemons on one PostgreSQL database', { skip }, () => {
     test('12 jobs spread over all three; kill -9 of one mid-run: every job done as the command line computes it, none run twice at once', async (t) => {
         const dir = tempDir('cluster');
         const db = pgDatabase();
-        // four starts, three jobs each: 1 to 3 s of steps alone
+        // four starts, three jobs each: 3 to 6 s of steps alone, so a job
+        // whose stored progress is seen has time left to be killed in
         const starts = ['3.1', '4.1', '5.1', '5.2'];
-        const STEPS = 700;
+        const STEPS = 2000;
         const options = ['--autoscale', '--resolution', '4', '--steps', String(STEPS)];
         const cli = await Promise.all(starts.map((k) => tighten(dir, join(CATALOGUE, `${k}.vect`), k, options)));
 
@@ -37,7 +38,9 @@ describe('three daemons on one PostgreSQL database', { skip }, () => {
             }));
 
         // kill daemon 1 while it runs a job that it has stored beyond its
-        // start (the store is written every 2 s) and not ended
+        // start (the store is written every 2 s) and not ended; a job
+        // stored past three quarters of its steps may end before the kill
+        // lands, so it is not chosen
         const victim = daemons[1];
         let target;
         for (const t0 = Date.now(); !target; await sleep(20)) {
@@ -47,11 +50,19 @@ describe('three daemons on one PostgreSQL database', { skip }, () => {
                 !lines.some((l) => l.id === s.id && l !== s && l.ms >= s.ms));
             for (const s of open) {
                 const stored = (await daemons[0].get(`/v1/jobs/${s.id}`)).json;
-                if (stored.state === 'running' && stored.progress.step > 0) target = s;
+                if (stored.state === 'running' && stored.progress.step > 0 &&
+                    stored.progress.step <= 0.75 * STEPS) target = s;
             }
         }
         await victim.kill();
         const killedAt = Date.now();
+        // the job daemon 1 held at the kill, from its own log: the one
+        // chosen, unless that ended in the moment between
+        const killed = jobRuns([victim], { 0: killedAt }).find((r) => r.end === 'killed');
+        assert.ok(killed, `daemon 1 ran no job when it was killed:\n${victim.output()}`);
+        if (killed.id !== target.id)
+            t.diagnostic(`job ${target.id} ended before the kill; daemon 1 held job ${killed.id}`);
+        target = killed;
         const stored = (await daemons[0].get(`/v1/jobs/${target.id}`)).json;
         t.diagnostic(`killed daemon 1 while it ran job ${target.id}, stored at step ${stored.progress.step}`);
 
