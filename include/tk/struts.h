@@ -154,18 +154,19 @@ double tk_struts_shortest_brute(const tk_curve *c, tk_strut *where);
 bool tk_struts_pair_allowed(const tk_curve *c, tk_arc_rule rule, double tau,
                             size_t i, size_t j);
 
-/* Every vertex whose 2 * minrad is <= bound (kinks), appended to *out
- * (a malloc'd array the caller frees), *count set. */
 /* Whether the straight path from a to b (the same components and vertex
  * counts; every vertex moving at constant speed from its place on a to
  * its place on b) is an isotopy: no two edges that are not neighbours
  * meet on the way, so no strand passes through another and the knot or
  * link type is kept, whatever invariants can tell.  *embedded false also
- * when proving it takes more than 2,000 pieces of the path (edges coming
- * very close).  TK_ENOMEM only. */
+ * when two such edges come within 1e-6 of a's mean edge on the way (a
+ * meeting cannot be told from that by rounding), or when proving it
+ * takes more than 2,000 pieces of the path.  TK_ENOMEM only. */
 int tk_struts_path_embedded(const tk_curve *a, const tk_curve *b, bool *embedded,
                             tk_error *err);
 
+/* Every vertex whose 2 * minrad is <= bound (kinks), appended to *out
+ * (a malloc'd array the caller frees), *count set. */
 int tk_kinks_find(const tk_curve *c, double bound, tk_kink **out,
                   size_t *count, tk_error *err);
 
