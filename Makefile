@@ -88,7 +88,7 @@ BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
 .SECONDARY:
 
-.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-starts bench-service bench-cluster bench-catalogue \
+.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-starts bench-service bench-cluster bench-catalogue bench-jones \
 	lint headers clean fuzz fuzz-bin
 
 WEB_OUT := $(BUILD)/web
@@ -222,6 +222,13 @@ bench-cluster: deps all
 # The whole catalogue through the service (hours: see README, --slice).
 bench-catalogue: deps all
 	$(Q)node bench/catalogue.mjs --build $(BUILD) $(CATALOGUE)
+
+# The types the catalogue bench ended at, against its files' by the Jones
+# polynomial (Regina's, from Debian's regina-normal): after a table run.
+bench-jones: deps
+	$(Q)./tools/install-deps.sh regina-normal
+	$(Q)./bench/jones.py --db $(BUILD)/catalogue/jobs.db --catalogue $(CATALOGUE) \
+		--starts $(BUILD)/catalogue/starts
 
 # Banned unsafe calls (curl's list); and each engine file calls only those
 # below it (engine/run.h's order), read from the objects' symbols.

@@ -1,7 +1,8 @@
 #!/bin/sh
-# Installs the Debian packages tightknot needs, quietly when all are there.
+# Installs the Debian packages tightknot needs, quietly when all are there;
+# packages given as arguments are installed too (a bench's own).
 set -eu
-packages="build-essential pkg-config check clang libsuitesparse-dev liblapack-dev
+packages="$* build-essential pkg-config check clang libsuitesparse-dev liblapack-dev
 libblas-dev libjansson-dev libmicrohttpd-dev libsqlite3-dev libcurl4-openssl-dev libgnutls28-dev libpq-dev postgresql
 wrk sqlite3 curl openssl chromium firefox-esr xvfb"
 missing=""
