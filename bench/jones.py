@@ -12,7 +12,10 @@ polynomial is the file's mirror image is reported as one (a ropelength
 does not tell mirror images apart; the engine's check does not either).
 
   bench/jones.py [--db build/catalogue/jobs.db] [--catalogue DIR]
-                 [--starts DIR] [--only NAME ...]
+                 [--starts DIR] [--only NAME ...] [--all]
+
+Each start's last job is checked (the one the table holds), every job
+with --all.
 
 Prints a line for each curve whose type is not the file's, then
 "jones: N curves, S the file's, M its mirror image, D other"; the exit
@@ -173,16 +176,21 @@ def main():
     ap.add_argument('--starts', help="also check the bench's starts in this directory "
                     "(build/catalogue/starts) against their files")
     ap.add_argument('--only', nargs='*', help='only these knots and links (catalogue names)')
+    ap.add_argument('--all', action='store_true',
+                    help='every job, not only the last of each start (the one the table holds)')
     a = ap.parse_args()
     if not os.path.exists(a.db):
         sys.stderr.write(f'bench/jones.py: {a.db}: no such job store (run bench/catalogue.mjs)\n')
         return 2
-    curves = []
+    latest = {}
     with sqlite3.connect(f'file:{a.db}?mode=ro', uri=True) as db:
         for jid, doc, curve in db.execute(
                 "select id, doc, curve from jobs where state = 'done' order by id"):
             name = json.loads(doc)['name']
-            curves.append((f'job {jid} {name}', name.split('@')[0], curve))
+            # a start run again replaces its row in the table: its last job
+            key = name if not a.all else jid
+            latest[key] = (f'job {jid} {name}', name.split('@')[0], curve)
+    curves = list(latest.values())
     if a.starts:
         for f in sorted(os.listdir(a.starts)):
             if f.endswith('.vect'):
