@@ -1031,7 +1031,7 @@ int tk_kinks_find(const tk_curve *c, double bound, tk_kink **out, size_t *count,
  * down to the rounding of the vertices' places (1e-16 of them) a piece
  * steps over it: an escape's far deformation of catalogue 10.140's
  * turned start (tests/data/path-through-*.vect) went through edges 31
- * and 102 that way in 50 pieces, was taken for an isotopy, and the run
+ * and 102 that way in its 53rd piece, was taken for an isotopy, and the run
  * tightened 8_20 (whose Alexander polynomial 10_140 shares) to 63.14.
  * So a distance below PATH_FLOOR of the mean edge proves nothing: two
  * edges that close count as meeting. */
@@ -1058,12 +1058,13 @@ int tk_struts_path_embedded(const tk_curve *a, const tk_curve *b, bool *embedded
     /* the arc rule with a vanishing diameter: every vertex may turn by all
      * but nothing of pi, so every pair of edges but neighbours is looked at */
     double tiny = 1e-9 * shortest;
-    double floor = rc ? 0.0 : PATH_FLOOR * tk_curve_length(a) / (double)tk_curve_edge_count(a);
+    size_t edges = tk_curve_edge_count(a);
+    double meeting = edges ? PATH_FLOOR * tk_curve_length(a) / (double)edges : 0.0;
     double s = 0.0;
     for (int piece = 0; !rc && piece < PATH_PIECES; piece++) {
         double dist;
         rc = tk_strut_finder_closest_pair(f, x, TK_ARC_ADMISSIBLE, tiny, INFINITY, &dist, err);
-        if (rc || !(dist > floor))
+        if (rc || !(dist > meeting))
             break;
         if (!(most > 0.0) || s + PATH_SHARE * dist / most >= 1.0) {
             *embedded = true;
