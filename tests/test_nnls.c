@@ -816,6 +816,48 @@ START_TEST(repeat_solves_are_identical)
 }
 END_TEST
 
+/* The columns' ordering is kept for the next solve of the same pattern
+ * (nnls.c, order_columns): a solver that has solved another pattern of
+ * the same size in between, one whose first column meets another vertex,
+ * answers each bit for bit as a fresh solver does. */
+START_TEST(the_columns_order_serves_its_pattern_only)
+{
+    tk_nnls *s = new_solver();
+    cholmod_common *cc = tk_nnls_common(s);
+    tkt_rng r = {11};
+    size_t V = 500, n = 900;
+    cholmod_sparse *A = flow_matrix(cc, &r, V, n);
+    cholmod_sparse *B = cholmod_copy_sparse(A, cc);
+    ck_assert_ptr_nonnull(B);
+    /* B: column 0's last vertex moved to vertex V - 1 (rows stay sorted) */
+    int *Bp = B->p, *Bi = B->i;
+    int last = Bi[Bp[1] - 1] / 3;
+    ck_assert_int_lt(last, (int)V - 1);
+    for (int c = 0; c < 3; c++)
+        Bi[Bp[1] - 3 + c] = 3 * ((int)V - 1) + c;
+    double *b = random_vector(&r, 3 * V);
+    double *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y);
+    ck_assert(x && y);
+    const cholmod_sparse *order[] = {A, B, A, B, B};
+    for (int k = 0; k < 5; k++) {
+        tk_nnls_report rep, fresh;
+        ck_assert_int_eq(solve(s, order[k], b, x, NULL, &rep), TK_OK);
+        tk_nnls *t = new_solver();
+        ck_assert_int_eq(solve(t, order[k], b, y, NULL, &fresh), TK_OK);
+        tk_nnls_free(&t);
+        ck_assert_int_ge(rep.factorisations, 1);
+        ck_assert_msg(memcmp(x, y, n * sizeof *x) == 0, "solve %d differs from a fresh one", k);
+        ck_assert_int_eq(rep.iterations, fresh.iterations);
+    }
+    free(b);
+    free(x);
+    free(y);
+    cholmod_free_sparse(&A, cc);
+    cholmod_free_sparse(&B, cc);
+    tk_nnls_free(&s);
+}
+END_TEST
+
 /* g = A^T du - r (n entries). */
 static void transpose_residual(const cholmod_sparse *A, const double *du, const double *r,
                                double *g)
@@ -1490,6 +1532,7 @@ int main(void)
     tcase_add_test(tc, degenerate_problems);
     tcase_add_test(tc, invalid_input_and_iteration_limit);
     tcase_add_test(tc, repeat_solves_are_identical);
+    tcase_add_test(tc, the_columns_order_serves_its_pattern_only);
     tcase_add_test(tc, min_norm_solutions);
     tcase_add_test(tc, damped_min_norm_steps);
     tcase_add_test(tc, damped_steps_in_a_metric);
