@@ -88,7 +88,7 @@ BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
 .SECONDARY:
 
-.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-starts bench-service bench-cluster bench-catalogue bench-jones \
+.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-starts bench-service bench-cluster bench-catalogue bench-jones bench-extrapolate \
 	lint headers clean fuzz fuzz-bin
 
 WEB_OUT := $(BUILD)/web
@@ -229,6 +229,11 @@ bench-jones: deps
 	$(Q)./tools/install-deps.sh regina-normal
 	$(Q)./bench/jones.py --db $(BUILD)/catalogue/jobs.db --catalogue $(CATALOGUE) \
 		--starts $(BUILD)/catalogue/starts
+
+# The smooth limit of the trefoil's ropelength from its tight polygons at
+# 1200 to 9600 vertices (75 minutes: see README).
+bench-extrapolate: deps all
+	$(Q)node bench/extrapolate.mjs --build $(BUILD) --catalogue $(CATALOGUE) --reference 32.742934
 
 # Banned unsafe calls (curl's list); and each engine file calls only those
 # below it (engine/run.h's order), read from the objects' symbols.

@@ -1,7 +1,8 @@
 // A node:test reporter that counts the tests that ran (leaves only: a
 // suite or a test with subtests is not counted again), prints "FAIL name"
 // for each failure and "SKIP name: why" for each skipped test, and ends
-// with "service: N passed, M failed, K skipped" (a skipped test is not a
+// with "NAME: N passed, M failed, K skipped", NAME TK_SUMMARY_NAME's or
+// "service" (a skipped test is not a
 // passed one).  A test file that fails outside any test counts as one
 // failure.
 export default async function* summary(source) {
@@ -23,9 +24,9 @@ export default async function* summary(source) {
             passed++;
         } else {
             failed++;
-            const where = file ? ` (${file.replace(/^.*\/tests\/service\//, '')})` : '';
+            const where = file ? ` (${file.replace(/^.*\/tests\/[^/]+\//, '')})` : '';
             yield `FAIL ${name}${where}\n`;
         }
     }
-    yield `service: ${passed} passed, ${failed} failed, ${skipped} skipped\n`;
+    yield `${process.env.TK_SUMMARY_NAME ?? 'service'}: ${passed} passed, ${failed} failed, ${skipped} skipped\n`;
 }
