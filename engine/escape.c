@@ -89,12 +89,15 @@ void tk_escape_start(tk_run *r, bool resumed, const tk_curve *start)
     r->escape.rng = r->opt.seed;
     r->escape.coarse = r->escape.best_coarse = NAN;
     r->escape.explore_over = resumed; /* its exploration's best is not kept */
+    if (!resumed && r->escape.most > 0 && !start->npins)
+        (void)tk_curve_copy(start, &r->escape.start, NULL); /* none: a plateau's turn instead */
 }
 
 void tk_escape_free(tk_run *r)
 {
     tk_curve_free(&r->escape.best);
     tk_curve_free(&r->escape.explored);
+    tk_curve_free(&r->escape.start);
     tk_constraints_free(&r->escape.best_set);
     free(r->escape.log);
 }
@@ -488,6 +491,38 @@ static tk_escape *log_entry(tk_run *r, tk_error *err)
     return &r->escape.log[r->escape.nlog++];
 }
 
+/* The first explored try is the run's start turned inside out about its
+ * centroid (tk_relax_turn), not the plateau: which basin a run ends in
+ * is mostly its start's shape's, and the turn of a loose start is a shape
+ * of the same type that the tightened curve's turn does not reach.  The
+ * table's turned start is the same turn (`generate turn`, on the file's
+ * vertices), and turned again it is near the file's shape: the two
+ * starts each try the other's shape.  Fourteen knots of 9 and 10
+ * crossings whose starts disagreed in the table, the file's start and
+ * the turned one each (resolution 5, 60 s): within 0.1% of the lowest
+ * 18 runs of 28 against 14 with the plateau's turn first, both starts of
+ * a knot in 7 knots against 3, their excess over it summed 4.4% against
+ * 16.1%; 10.146 and 10.23 went below the table's lowest (79.780 against
+ * 79.831, 88.150 against 88.484), 10.63's file the other way (0.50%
+ * above; bench/FIGURES.md).  On TURN_RESOLUTION vertices a unit of the
+ * plateau's ropelength, as a turn of the plateau; *out is the turned
+ * curve, TK_ENUMERIC when there is none to make (no start kept, or the
+ * turn refused), and a plateau's try is made instead. */
+static int turned_start(tk_run *r, tk_curve **out, tk_error *err)
+{
+    if (!r->escape.start)
+        return TK_ENUMERIC;
+    double offset[3] = {0.0, 0.0, 0.0};
+    size_t count = (size_t)(TURN_RESOLUTION * r->escape.explored_rope);
+    if (count < 8 * r->escape.start->ncomp)
+        count = 8 * r->escape.start->ncomp;
+    tk_error why;
+    int rc = tk_relax_turn(r->escape.start, offset, count, TURN_STEPS, out, &why);
+    if (rc == TK_ENOMEM)
+        return tk_error_set(err, rc, "%s", why.message);
+    return rc ? TK_ENUMERIC : TK_OK;
+}
+
 /* Before a step asked for by explore(): the next explored try, or the
  * lowest curve back. */
 static int explore_next(tk_run *r, tk_error *err)
@@ -504,8 +539,13 @@ static int explore_next(tk_run *r, tk_error *err)
     double amplitude = 0.0;
     bool turned = false;
     bool loose = false;
-    rc = try_curve(r, r->escape.explored, r->escape.explored_thickness, r->escape.explored_rope,
-                   r->escape.explore_tries, &curve, &amplitude, &turned, &loose, err);
+    rc = r->escape.explore_tries == 0 ? turned_start(r, &curve, err) : TK_ENUMERIC;
+    if (rc == TK_OK)
+        turned = loose = true;
+    else if (rc == TK_ENUMERIC)
+        rc = try_curve(r, r->escape.explored, r->escape.explored_thickness,
+                       r->escape.explored_rope, r->escape.explore_tries, &curve, &amplitude,
+                       &turned, &loose, err);
     tk_escape *e = rc ? NULL : log_entry(r, err);
     if (!e) {
         tk_curve_free(&curve);

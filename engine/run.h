@@ -216,6 +216,8 @@ struct tk_run {
         /* exploration: tries on the coarsest polygon alone, before the
            run first refines from it */
         tk_curve *explored;  /* the lowest plateau there so far, or NULL */
+        tk_curve *start;     /* the start as given, for the first explored
+                                try (NULL: none, or no memory for it) */
         double explored_rope, explored_thickness;
         int explore_tries;   /* logged among the tries, not counted
                                 against the escapes option's */

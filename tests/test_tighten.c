@@ -2150,16 +2150,19 @@ static void loose_run_end(tk_run **run, tk_invariants *type)
 /* A loose polygon follows the ropelength down only where the fewer
  * vertices keep the type (tk_schedule_before_step): a far start of
  * catalogue 9.45 (wandered as `tightknot generate wander 9.45.vect 1`
- * makes it), at resolution 5 with two loose levels, starts its first
- * explored try at step 3,968, a turned curve of ropelength 261 on a loose
- * level of 196 vertices.  That step's check once read the ropelength of
- * the last report, the curve the try replaced (74.93), which calls for 47
- * vertices; the try's curve resampled to 47 is another knot, and the run
- * failed there (the type check after the resampling) before the guard.
- * The try's level follows its own ropelength down (a try's first step is
- * not judged now; a_loose_try_starts_on_its_own_count): it has fewer
- * vertices than it started with before step 4,500 (judged from the
- * replaced curve's ropelength, the level stayed at 196 for 6,500 steps).
+ * makes it), at resolution 5 with two loose levels, started its first
+ * explored try at step 3,968, the plateau turned, of ropelength 261 on a
+ * loose level of 196 vertices.  That step's check once read the
+ * ropelength of the last report, the curve the try replaced (74.93),
+ * which calls for 47 vertices; the try's curve resampled to 47 is another
+ * knot, and the run failed there (the type check after the resampling)
+ * before the guard.  The try's level follows its own ropelength down (a
+ * try's first step is not judged now; a_loose_try_starts_on_its_own_count):
+ * it has fewer vertices than it started with by step 12,000 (judged from
+ * the replaced curve's ropelength, the level stayed at 196 for 6,500
+ * steps).  The first explored try is now the start turned (escape.c,
+ * turned_start): 234.81 on 170 vertices, replacing 74.93, down to 127 by
+ * step 4,636.
  * Every step is taken, each polygon of the start's type (the run checks
  * every resampling), and the curve at the end is of the start's type by
  * the invariants computed here. */
@@ -2177,7 +2180,7 @@ START_TEST(a_loose_level_keeps_its_polygon_where_fewer_vertices_lose_the_type)
     tk_error err;
     size_t first = 0, least = SIZE_MAX;
     double replaced = NAN, from = NAN;
-    while (tk_run_latest(run)->step < 4500) {
+    while (tk_run_latest(run)->step < 12000 && !(least < first)) {
         double before = tk_run_latest(run)->ropelength;
         ck_assert_msg(tk_run_step(run, &err) == TK_OK, "step %ld: %s", tk_run_latest(run)->step,
                       err.message);
@@ -2208,16 +2211,19 @@ END_TEST
 /* A loose try starts on the polygon its own curve calls for, not the one
  * the curve it replaced would (tk_schedule_before_step): catalogue 2.2.1
  * (the Hopf link) at resolution 5 with two loose levels tries a far
- * escape at step 2,425, a curve of ropelength about 147 replacing one of
- * 25.22.  At the loose level's 0.625 vertices a unit (5 halved for the
+ * escape at step 2,462 (its second try), a curve of ropelength about 147
+ * replacing one of 25.22.  At the loose level's 0.625 vertices a unit (5 halved for the
  * coarsest level and twice more for the loose ones) the replaced curve's
  * ropelength calls for ceil(0.625 * 25.22) = 16 vertices, and the try's
  * own for 92; before, the try's first step resampled it to those 16, a
  * tenth of a vertex per unit of its length (its first step measured 141
  * on them, 226.6 on its own 92).  Every try that starts more
  * than 4/3 looser than the curve it replaces (where that resampling was
- * due) has more than twice the replaced curve's count on its first step,
- * and the run ends of the start's type. */
+ * due) has more than the replaced curve's count on its first step, more
+ * than twice that count where it starts more than twice as loose (the
+ * first try, the start turned inside out, now comes at step 959 at 34.95
+ * on 21 vertices, replacing 25.22), and the run ends of the start's
+ * type. */
 START_TEST(a_loose_try_starts_on_its_own_count)
 {
     const char *name = "a_loose_try_starts_on_its_own_count";
@@ -2231,7 +2237,7 @@ START_TEST(a_loose_try_starts_on_its_own_count)
     tk_error err;
     long restarts = 0;
     int far = 0;
-    while (tk_run_latest(run)->step < 2500) {
+    while (tk_run_latest(run)->step < 6000) {
         tk_step_report before = *tk_run_latest(run);
         ck_assert_msg(tk_run_step(run, &err) == TK_OK, "step %ld: %s", before.step, err.message);
         const tk_step_report *s = tk_run_latest(run);
@@ -2243,6 +2249,9 @@ START_TEST(a_loose_try_starts_on_its_own_count)
                "the loose level)\n", restarts, s->step, s->vertices, s->ropelength,
                before.ropelength, replaced);
         if (!(s->ropelength > before.ropelength * 4.0 / 3.0))
+            continue;
+        ck_assert_uint_gt(s->vertices, replaced);
+        if (!(s->ropelength > before.ropelength * 2.0))
             continue;
         far++;
         ck_assert_uint_gt(s->vertices, 2 * replaced);
@@ -2850,10 +2859,10 @@ END_TEST
  * figure-eight, disguised (seed 14, perturbation 0.01), at resolution 5:
  * its coarse levels stop at 55.30 with kinks at the curvature bound,
  * and its final polygon, refined from there, took 60,000 steps to come
- * down.  With a budget of 32,000 steps the first explored try (the
- * plateau turned inside out) leaves it for the tight knot's basin (42.18)
- * and the run ends within 0.2% of the best known 4_1 (42.09703, 400
- * vertices).  Without loose levels: with them (the default) the first
+ * down.  With a budget of 32,000 steps an explored try leaves it for the
+ * tight knot's basin (the plateau turned inside out, when it was the
+ * first, at 42.18) and the run ends within 0.2% of the best known 4_1
+ * (42.09703, 400 vertices).  Without loose levels: with them (the default) the first
  * tightening passes the trap by, down to 42.13 on 212 vertices before
  * any try. */
 START_TEST(an_explored_try_leaves_a_coarse_trap)
@@ -2896,13 +2905,112 @@ START_TEST(an_explored_try_leaves_a_coarse_trap)
     ck_assert_uint_lt(left, nh);
     ck_assert(e[0].coarse == h[left - 1].ropelength);
     ck_assert(isnan(e[0].reached));
-    ck_assert(e[0].coarse < 0.9 * plateau && e[0].improved);
+    /* an explored try leaves the trap */
+    size_t k = 0;
+    while (k < ne && e[k].explored && !(e[k].coarse < 0.9 * plateau && e[k].improved))
+        k++;
+    for (size_t i = 0; i < ne; i++)
+        printf("try %zu: %s%s, from %.5f, coarse %.5f\n", i + 1,
+               e[i].explored ? "explored" : "on the final polygon",
+               e[i].turned ? ", turned" : "", e[i].from, e[i].coarse);
+    ck_assert_msg(k < ne && e[k].explored, "no explored try left the plateau at %.5f", plateau);
     const tk_step_report *end = tk_run_latest(run);
     double excess = end->ropelength / 42.09703 - 1.0;
-    printf("disguised figure-eight at resolution 5: plateau %.5f, explored try left it at %.5f; "
-           "ends at %.6f (%+.3f%%, %zu vertices), %zu tries\n", plateau, e[0].coarse,
-           end->ropelength, 100.0 * excess, end->vertices, ne);
+    printf("disguised figure-eight at resolution 5: plateau %.5f, explored try %zu left it at "
+           "%.5f; ends at %.6f (%+.3f%%, %zu vertices), %zu tries\n", plateau, k + 1,
+           e[k].coarse, end->ropelength, 100.0 * excess, end->vertices, ne);
     ck_assert_msg(fabs(excess) < 2e-3, "%.6f", end->ropelength);
+    tk_run_free(&run);
+    tk_curve_free(&d);
+    tk_curve_free(&c);
+}
+END_TEST
+
+/* The largest distance between like vertices of a and b (as many
+ * vertices) with each centred on its centroid and scaled to unit length,
+ * in mean edges: how far apart two polygons are as shapes, whatever
+ * their scale. */
+static double shape_gap(const tk_curve *a, const tk_curve *b)
+{
+    ck_assert_uint_eq(a->nvert, b->nvert);
+    const tk_curve *ab[2] = {a, b};
+    double centre[2][3] = {{0}}, scale[2];
+    for (int k = 0; k < 2; k++) {
+        for (size_t v = 0; v < a->nvert; v++)
+            for (int j = 0; j < 3; j++)
+                centre[k][j] += ab[k]->xyz[3 * v + j] / (double)a->nvert;
+        scale[k] = 1.0 / tk_curve_length(ab[k]);
+    }
+    double gap = 0.0;
+    for (size_t v = 0; v < a->nvert; v++) {
+        double d2 = 0.0;
+        for (int j = 0; j < 3; j++) {
+            double x = (a->xyz[3 * v + j] - centre[0][j]) * scale[0];
+            double y = (b->xyz[3 * v + j] - centre[1][j]) * scale[1];
+            d2 += (x - y) * (x - y);
+        }
+        gap = fmax(gap, sqrt(d2));
+    }
+    return gap * (double)a->nvert;
+}
+
+/* The first explored try is the start turned inside out (escape.c,
+ * turned_start), not the plateau: the figure-eight's disguise of the test
+ * above (loose levels off, so that the try comes onto the coarsest
+ * polygon at once).  After the try's first step the curve is, as a
+ * shape, within a quarter of an edge of the start turned about its
+ * centroid on 1.5 vertices a unit of the plateau's ropelength and
+ * resampled to that polygon, made here apart (a step moves no vertex by
+ * more than that); the plateau turned so is ten times as far from it, so
+ * the test tells the two apart (0.02 and 1.22 edges: a disguised
+ * figure-eight and its plateau are alike as shapes, a catalogue file and
+ * its tightened curve less so). */
+START_TEST(the_first_explored_try_turns_the_start)
+{
+    tk_curve *c = NULL, *d = NULL;
+    ck_assert_int_eq(tk_generate_figure_eight(200, &c, NULL), TK_OK);
+    ck_assert_int_eq(tk_generate_disguise(c, 14, 0.01, &d, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 5;
+    o.loose = 0;
+    o.max_steps = 32000;
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(d, &o, &run, &err), TK_OK);
+    size_t ne = 0, nh = 0;
+    tk_curve *plateau = NULL;
+    while (tk_run_escapes(run, &ne), ne == 0) {
+        tk_curve_free(&plateau);
+        ck_assert_int_eq(tk_curve_copy(tk_run_curve(run), &plateau, NULL), TK_OK);
+        int rc = tk_run_step(run, &err);
+        ck_assert_msg(rc == TK_OK, "%s", err.message);
+        ck_assert_int_lt(tk_run_latest(run)->step, o.max_steps);
+    }
+    const tk_escape *e = tk_run_escapes(run, &ne);
+    ck_assert(e[0].explored && e[0].turned);
+    const tk_step_report *h = tk_run_history(run, &nh);
+    ck_assert_int_eq(h[nh - 1].escapes, 1);
+    ck_assert(e[0].from == h[nh - 2].ropelength);
+    const tk_curve *now = tk_run_curve(run);
+    size_t count = (size_t)(1.5 * e[0].from);
+    double offset[3] = {0.0, 0.0, 0.0}, gap[2];
+    const tk_curve *from[2] = {d, plateau};
+    for (int k = 0; k < 2; k++) {
+        tk_curve *t = NULL, *u = NULL;
+        ck_assert_int_eq(tk_relax_turn(from[k], offset, count, 3000, &t, &err), TK_OK);
+        ck_assert_int_eq(tk_curve_resample_total(t, now->nvert, &u, &err), TK_OK);
+        gap[k] = shape_gap(now, u);
+        tk_curve_free(&t);
+        tk_curve_free(&u);
+    }
+    printf("the first explored try after its first step, %zu vertices: %.3f edges from the start "
+           "turned, %.3f from the plateau (%.4f) turned\n", now->nvert, gap[0], gap[1],
+           e[0].from);
+    ck_assert_msg(gap[0] < 0.25, "%.3f edges from the start turned", gap[0]);
+    ck_assert_msg(gap[1] > 0.5 && gap[1] > 10.0 * gap[0], "the plateau's turn is %.3f edges from it",
+                  gap[1]);
+    tk_curve_free(&plateau);
     tk_run_free(&run);
     tk_curve_free(&d);
     tk_curve_free(&c);
@@ -2931,6 +3039,7 @@ int main(void)
     tcase_add_test(tc, a_run_that_tried_no_escape_returns_its_best);
     tcase_add_test(tc, a_try_behind_on_its_coarsest_polygon_is_given_up_there);
     tcase_add_test(tc, an_explored_try_leaves_a_coarse_trap);
+    tcase_add_test(tc, the_first_explored_try_turns_the_start);
     tcase_add_test(tc, converge_stops_where_the_flow_has_no_more_to_give);
     tcase_add_test(tc, the_defaults_tighten_the_figure_eight);
     tcase_add_test(tc, re_resolution_keeps_the_resolution);

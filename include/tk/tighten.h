@@ -137,7 +137,7 @@
       "little) and tightened again; the last fifth polishes the best curve; the "            \
       "result is the best curve found; before that, in the first half of the budget, "       \
       "as many tries again explore the coarsest polygon alone, from the lowest curve found " \
-      "there (0: none)")                                                                     \
+      "there, the first of them the start turned inside out (0: none)")                      \
     X(seed, SEED, 1, 0, 9007199254740991.0, "seed",                                          \
       "of the escapes' random deformations: the same seed, the same run (below 2^53, so "    \
       "that every seed is exact as a JSON number)")
