@@ -501,8 +501,8 @@ static tk_escape *log_entry(tk_run *r, tk_error *err)
  * crossings whose starts disagreed in the table, the file's start and
  * the turned one each (resolution 5, 60 s): within 0.1% of the lowest
  * 18 runs of 28 against 14 with the plateau's turn first, both starts of
- * a knot in 7 knots against 3, their excess over it summed 4.4% against
- * 16.1%; 10.146 and 10.23 went below the table's lowest (79.780 against
+ * a knot in 6 knots against 3, their excess over it summed 4.5% against
+ * 16.2%; 10.146 and 10.23 went below the table's lowest (79.780 against
  * 79.831, 88.150 against 88.484), 10.63's file the other way (0.50%
  * above; bench/FIGURES.md).  On TURN_RESOLUTION vertices a unit of the
  * plateau's ropelength, as a turn of the plateau; *out is the turned
