@@ -336,6 +336,23 @@ enum { TRY_TURNED, TRY_FAR, TRY_NEAR, TRY_KINDS };
 #define TURN_RESOLUTION 1.5
 #define TURN_STEPS 3000
 
+/* c turned inside out about its centroid plus `offset` (of its spread),
+ * on TURN_RESOLUTION vertices a unit of `rope` (8 a component at least),
+ * into *out; TK_ENUMERIC when the turn is refused (a centre too near the
+ * curve, or too few vertices to turn it). */
+static int turn(const tk_curve *c, const double offset[3], double rope, tk_curve **out,
+                tk_error *err)
+{
+    size_t count = (size_t)(TURN_RESOLUTION * rope);
+    if (count < 8 * c->ncomp)
+        count = 8 * c->ncomp;
+    tk_error why;
+    int rc = tk_relax_turn(c, offset, count, TURN_STEPS, out, &why);
+    if (rc == TK_ENOMEM)
+        return tk_error_set(err, rc, "%s", why.message);
+    return rc ? TK_ENUMERIC : TK_OK;
+}
+
 /* Try number `index` (explored, or on the final polygon) from `best` (of
  * the given thickness and ropelength) into *out; *turned says whether it
  * was turned, *loose whether it starts on the loose levels (a turned or
@@ -363,18 +380,11 @@ static int try_curve(tk_run *r, const tk_curve *best, double thickness, double r
     tk_relax_turn_offset(&r->escape.rng, offset);
     if (index == TRY_TURNED) /* the first turn of the kind of tries: about the centroid */
         offset[0] = offset[1] = offset[2] = 0.0;
-    size_t count = (size_t)(TURN_RESOLUTION * rope);
-    if (count < 8 * best->ncomp)
-        count = 8 * best->ncomp;
     *amplitude = 0.0;
-    tk_error why;
-    int rc = tk_relax_turn(best, offset, count, TURN_STEPS, out, &why);
-    if (rc == TK_ENOMEM)
-        return tk_error_set(err, rc, "%s", why.message);
-    /* a centre too near the curve, or too few vertices to turn it: a far
-     * deformation instead */
+    int rc = turn(best, offset, rope, out, err);
+    /* refused: a far deformation instead */
     *turned = rc == TK_OK;
-    return rc ? deformed(r, best, thickness, true, out, amplitude, err) : TK_OK;
+    return rc == TK_ENUMERIC ? deformed(r, best, thickness, true, out, amplitude, err) : rc;
 }
 
 /* Exploration: before the run first refines its coarsest polygon, tries
@@ -510,17 +520,9 @@ static tk_escape *log_entry(tk_run *r, tk_error *err)
  * turn refused), and a plateau's try is made instead. */
 static int turned_start(tk_run *r, tk_curve **out, tk_error *err)
 {
-    if (!r->escape.start)
-        return TK_ENUMERIC;
-    double offset[3] = {0.0, 0.0, 0.0};
-    size_t count = (size_t)(TURN_RESOLUTION * r->escape.explored_rope);
-    if (count < 8 * r->escape.start->ncomp)
-        count = 8 * r->escape.start->ncomp;
-    tk_error why;
-    int rc = tk_relax_turn(r->escape.start, offset, count, TURN_STEPS, out, &why);
-    if (rc == TK_ENOMEM)
-        return tk_error_set(err, rc, "%s", why.message);
-    return rc ? TK_ENUMERIC : TK_OK;
+    static const double centroid[3] = {0.0, 0.0, 0.0};
+    return r->escape.start ? turn(r->escape.start, centroid, r->escape.explored_rope, out, err)
+                           : TK_ENUMERIC;
 }
 
 /* Before a step asked for by explore(): the next explored try, or the

@@ -84,13 +84,18 @@
 /* modifications of a factor before it is built afresh (see lh_sync) */
 #define NNLS_LH_REFRESH 200
 
+/* A copy of a matrix's pattern, what the caches below are kept for. */
+typedef struct nnls_pattern {
+    uint64_t hash;        /* pattern_hash */
+    size_t nrow, ncol, nnz; /* nrow 0: none */
+    int *p, *i;           /* ncol + 1 and nnz entries */
+} nnls_pattern;
+
 /* A cached symbolic analysis (and the last numeric factor) for one
  * pattern of T. */
 typedef struct nnls_slot {
     cholmod_factor *L;    /* NULL when the slot is empty */
-    uint64_t hash;
-    size_t nrow, ncol, nnz;
-    int *p, *i;           /* T's pattern: ncol + 1 and nnz entries */
+    nnls_pattern pattern; /* T's */
     double fl, lnz;       /* the analysis's flops and entries of L */
     unsigned long used;   /* least-recently-used stamp */
 } nnls_slot;
@@ -109,10 +114,8 @@ typedef struct nnls_kept {
 /* The last order_columns's ordering, for the pattern of A^T it was made
  * from (see order_columns). */
 typedef struct nnls_order {
-    uint64_t hash;
-    size_t nrow, ncol, nnz; /* nrow 0: none */
-    int *p, *i;           /* the pattern: ncol + 1 and nnz entries */
-    int *order;           /* nrow: AMD's ordering of its rows */
+    nnls_pattern pattern;
+    int *order;           /* pattern.nrow: AMD's ordering of its rows */
 } nnls_order;
 
 struct tk_nnls {
@@ -319,23 +322,57 @@ static uint64_t pattern_hash(const cholmod_sparse *T)
     return h;
 }
 
+static void pattern_clear(nnls_pattern *pat)
+{
+    free(pat->p);
+    free(pat->i);
+    memset(pat, 0, sizeof *pat);
+}
+
+/* Whether pat is T's pattern (hash h). */
+static bool pattern_is(const nnls_pattern *pat, const cholmod_sparse *T, uint64_t h)
+{
+    const int *Tp = T->p, *Ti = T->i;
+    size_t nnz = (size_t)Tp[T->ncol];
+    return pat->nrow > 0 && pat->hash == h && pat->nrow == T->nrow && pat->ncol == T->ncol &&
+           pat->nnz == nnz && memcmp(pat->p, Tp, (T->ncol + 1) * sizeof *Tp) == 0 &&
+           memcmp(pat->i, Ti, nnz * sizeof *Ti) == 0;
+}
+
+/* pat becomes a copy of T's pattern (hash h); false, and pat empty, when
+ * out of memory. */
+static bool pattern_keep(nnls_pattern *pat, const cholmod_sparse *T, uint64_t h)
+{
+    const int *Tp = T->p, *Ti = T->i;
+    size_t nnz = (size_t)Tp[T->ncol];
+    pattern_clear(pat);
+    pat->p = malloc((T->ncol + 1) * sizeof *pat->p);
+    pat->i = malloc((nnz ? nnz : 1) * sizeof *pat->i);
+    if (!pat->p || !pat->i) {
+        pattern_clear(pat);
+        return false;
+    }
+    memcpy(pat->p, Tp, (T->ncol + 1) * sizeof *Tp);
+    memcpy(pat->i, Ti, nnz * sizeof *Ti);
+    pat->hash = h;
+    pat->nrow = T->nrow;
+    pat->ncol = T->ncol;
+    pat->nnz = nnz;
+    return true;
+}
+
 static void slot_clear(tk_nnls *s, nnls_slot *slot)
 {
     if (slot->L)
         cholmod_free_factor(&slot->L, &s->cc);
-    free(slot->p);
-    free(slot->i);
+    pattern_clear(&slot->pattern);
     memset(slot, 0, sizeof *slot);
 }
 
 /* Whether slot holds the analysis of T's pattern (hash h). */
 static bool slot_holds(const nnls_slot *slot, const cholmod_sparse *T, uint64_t h)
 {
-    const int *Tp = T->p, *Ti = T->i;
-    size_t nnz = (size_t)Tp[T->ncol];
-    return slot->L && slot->hash == h && slot->nrow == T->nrow && slot->ncol == T->ncol &&
-           slot->nnz == nnz && memcmp(slot->p, Tp, (T->ncol + 1) * sizeof *Tp) == 0 &&
-           memcmp(slot->i, Ti, nnz * sizeof *Ti) == 0;
+    return slot->L && pattern_is(&slot->pattern, T, h);
 }
 
 static nnls_slot *slot_find(tk_nnls *s, const cholmod_sparse *T, uint64_t h)
@@ -352,14 +389,8 @@ static int slot_analyse(tk_nnls *s, nnls_slot *slot, const cholmod_sparse *T, co
                         uint64_t h, tk_error *err)
 {
     slot_clear(s, slot);
-    const int *Tp = T->p, *Ti = T->i;
-    size_t nnz = (size_t)Tp[T->ncol];
-    slot->p = malloc((T->ncol + 1) * sizeof *slot->p);
-    slot->i = malloc((nnz ? nnz : 1) * sizeof *slot->i);
-    if (!slot->p || !slot->i) {
-        slot_clear(s, slot);
+    if (!pattern_keep(&slot->pattern, T, h))
         return tk_error_set(err, TK_ENOMEM, "out of memory for the factor cache");
-    }
     /* cholmod_analyze takes a non-const matrix but does not change it */
     if (order) {
         s->cc.method[0].ordering = CHOLMOD_GIVEN;
@@ -373,12 +404,6 @@ static int slot_analyse(tk_nnls *s, nnls_slot *slot, const cholmod_sparse *T, co
         slot_clear(s, slot);
         return rc;
     }
-    memcpy(slot->p, Tp, (T->ncol + 1) * sizeof *Tp);
-    memcpy(slot->i, Ti, nnz * sizeof *Ti);
-    slot->hash = h;
-    slot->nrow = T->nrow;
-    slot->ncol = T->ncol;
-    slot->nnz = nnz;
     slot->fl = s->cc.fl;
     slot->lnz = s->cc.lnz;
     return TK_OK;
@@ -587,8 +612,7 @@ void tk_nnls_free(tk_nnls **p)
     free(s->kept.values);
     free(s->kept.in);
     free(s->order);
-    free(s->columns.p);
-    free(s->columns.i);
+    pattern_clear(&s->columns.pattern);
     free(s->columns.order);
     cholmod_free_dense(&s->X, &s->cc);
     cholmod_free_dense(&s->Y, &s->cc);
@@ -716,44 +740,18 @@ static void transpose_all(nnls_work *w, cholmod_sparse *T)
     build_transpose(w->A, w->place, w->n, w->inv_norm, T, w->next);
 }
 
-/* Whether the solver's last columns' order was made for T's pattern
- * (hash h). */
-static bool order_holds(const nnls_order *o, const cholmod_sparse *T, uint64_t h)
-{
-    const int *Tp = T->p, *Ti = T->i;
-    size_t nnz = (size_t)Tp[T->ncol];
-    return o->nrow > 0 && o->hash == h && o->nrow == T->nrow && o->ncol == T->ncol &&
-           o->nnz == nnz && memcmp(o->p, Tp, (T->ncol + 1) * sizeof *Tp) == 0 &&
-           memcmp(o->i, Ti, nnz * sizeof *Ti) == 0;
-}
-
 /* Keeps `order` as the ordering of T's pattern (hash h); out of memory,
  * nothing is kept and the next solve orders afresh. */
 static void order_keep(nnls_order *o, const cholmod_sparse *T, uint64_t h, const int *order)
 {
-    const int *Tp = T->p, *Ti = T->i;
-    size_t nnz = (size_t)Tp[T->ncol];
-    free(o->p);
-    free(o->i);
-    free(o->order);
-    memset(o, 0, sizeof *o);
-    o->p = malloc((T->ncol + 1) * sizeof *o->p);
-    o->i = malloc((nnz ? nnz : 1) * sizeof *o->i);
-    o->order = malloc(T->nrow * sizeof *o->order);
-    if (!o->p || !o->i || !o->order) {
-        free(o->p);
-        free(o->i);
-        free(o->order);
-        memset(o, 0, sizeof *o);
+    int *kept = realloc(o->order, T->nrow * sizeof *kept);
+    if (kept)
+        o->order = kept;
+    if (!kept || !pattern_keep(&o->pattern, T, h)) {
+        pattern_clear(&o->pattern);
         return;
     }
-    memcpy(o->p, Tp, (T->ncol + 1) * sizeof *Tp);
-    memcpy(o->i, Ti, nnz * sizeof *Ti);
     memcpy(o->order, order, T->nrow * sizeof *order);
-    o->hash = h;
-    o->nrow = T->nrow;
-    o->ncol = T->ncol;
-    o->nnz = nnz;
 }
 
 /* Made when the n_F x n_F form is first needed: where the coordinate
@@ -771,7 +769,7 @@ static int order_columns(nnls_work *w, tk_error *err)
     transpose_all(w, w->T);
     nnls_order *o = &w->s->columns;
     uint64_t h = pattern_hash(w->T);
-    if (order_holds(o, w->T, h)) {
+    if (pattern_is(&o->pattern, w->T, h)) {
         memcpy(w->order, o->order, w->n * sizeof *w->order);
     } else {
         if (!cholmod_amd(w->T, NULL, 0, w->order, &w->s->cc) || w->s->cc.status < CHOLMOD_OK)
