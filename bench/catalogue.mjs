@@ -46,6 +46,10 @@
 //   --far K           far starts per knot (generate wander), seeds 1..K (default 1)
 //   --turn K          turned starts per knot, seeds 0..K-1 (default 1)
 //   --parallel N      starts running at once (default: the cores)
+//   --worker-priority P  its own daemon's workers: normal (default), low or
+//                     idle (tightknotd --worker-priority); idle workers
+//                     get only what nothing else wants, and a slice beside
+//                     other busy work then crawls
 //   --loose K         the run option loose (0 to 2, default 2): the first
 //                     tightening and the loose tries start K halvings below
 //                     the coarse level
@@ -69,6 +73,7 @@ const opt = {
     server: null, token: process.env.TIGHTKNOT_TOKEN ?? null, slice: '1/1', seconds: 60,
     resolution: 5, far: 1, turn: 1, parallel: cpus().length, out: 'build/catalogue',
     table: 'docs/catalogue.tsv', build: 'build', only: null, tableOnly: false, loose: 2, engine: null,
+    workerPriority: 'normal',
     catalogue: '../shared/catalogue',
 };
 for (let i = 0; i < argv.length; i++) {
@@ -85,6 +90,7 @@ for (let i = 0; i < argv.length; i++) {
     else if (a === '--far') opt.far = Number(value());
     else if (a === '--turn') opt.turn = Number(value());
     else if (a === '--parallel') opt.parallel = Number(value());
+    else if (a === '--worker-priority') opt.workerPriority = value();
     else if (a === '--loose') opt.loose = Number(value());
     else if (a === '--engine') opt.engine = value();
     else if (a === '--out') opt.out = value();
@@ -103,6 +109,7 @@ for (const k of ['seconds', 'resolution', 'parallel'])
 if (!(Number.isInteger(opt.far) && opt.far >= 0)) usage('--far must be a whole number >= 0');
 if (!(Number.isInteger(opt.turn) && opt.turn >= 0)) usage('--turn must be a whole number >= 0');
 if (!(Number.isInteger(opt.loose) && opt.loose >= 0 && opt.loose <= 2)) usage('--loose must be 0, 1 or 2');
+if (!['normal', 'low', 'idle'].includes(opt.workerPriority)) usage('--worker-priority must be normal, low or idle');
 // the settings a slice ran with, kept beside its results: the table's
 // rows carry their own slice's
 const settingsText = (loose, engine) => `resolution ${opt.resolution}, ${opt.seconds} s of processor time `
@@ -238,7 +245,8 @@ function makeStarts(name) {
 
 async function ownDaemon() {
     const proc = spawn(DAEMON, ['--port', '0', '--db', join(out, 'jobs.db'),
-        '--workers', String(opt.parallel), '--max-per-address', '1000'], { stdio: ['ignore', 'pipe', 'inherit'] });
+        '--workers', String(opt.parallel), '--worker-priority', opt.workerPriority, '--max-per-address', '1000'],
+    { stdio: ['ignore', 'pipe', 'inherit'] });
     const port = await new Promise((res, rej) => {
         let text = '';
         proc.stdout.setEncoding('utf8').on('data', (d) => {
