@@ -370,10 +370,12 @@ static void fix_final(tk_run *r, double rope)
 }
 
 /* The run's curve: a copy of the start, resampled to the resolution (of
- * the coarsest level) and autoscaled, or refused. */
-static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
+ * the coarsest level) and autoscaled, or refused.  *correct is set where
+ * the curve still needs Newton steps (below). */
+static int prepare_curve(tk_run *r, const tk_curve *start, bool *correct, tk_error *err)
 {
     tk_measure m;
+    *correct = false;
     tk_curve **curve = &r->shared.curve;
     if (start->nvert > TK_RUN_MAX_VERTICES)
         return tk_error_set(err, TK_ELIMIT,
@@ -393,7 +395,7 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
     if (rc)
         return rc;
     r->schedule.start_ropelength = reckoned_ropelength(*curve, &m);
-    double start_rope = m.ropelength;
+    double start_rope = m.ropelength, start_thickness = m.thickness;
     if (!(m.ropelength <= START_ROPELENGTH_MAX))
         return tk_error_set(err, TK_EINVAL,
                             "the curve is too thin for its length to tighten in double "
@@ -411,6 +413,7 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
         r->schedule.loose = loose_levels(r);
         r->schedule.coarse_level = r->schedule.coarse_levels + r->schedule.loose;
         tk_curve *resampled = NULL;
+        size_t given = (*curve)->nvert;
         rc = tk_curve_resample_total(*curve, level_count(r, r->schedule.start_ropelength),
                                      &resampled, err);
         if (rc)
@@ -428,9 +431,28 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
                                 start_rope);
         if (rc)
             return rc;
+        /* A start refined to more vertices than it has, whose spline is
+         * thinner than its polygon, is one the spline cuts where it bends
+         * at the curvature bound or between contacts: a tight curve.
+         * Scaled to the tube by the spline's thickness it loses every
+         * contact (catalogue 3.1 tightened at 4,800 vertices, 32.74300,
+         * resampled to 9,600 was 3.5% loose, and took 1,944 s to come
+         * back to 32.7506); scaled by its polygon's, the few vertices that
+         * cut the tube are put back by Newton steps, as a run's own
+         * refinement does (resample_to).  Spline resampling commutes with
+         * scaling, so this is the polygon scaled, then resampled.  Only
+         * for a start put on its final polygon: a coarse level's flow
+         * tightens a looser start anyway, at a fraction of the cost. */
+        if (r->opt.autoscale && (*curve)->nvert > given && m.thickness < start_thickness &&
+            r->schedule.coarse_level == 0) {
+            m.thickness = start_thickness;
+            *correct = true;
+        }
     }
     if (r->opt.autoscale) {
-        double factor = r->opt.autoscale_margin * r->tau / m.thickness;
+        /* (a curve to be corrected keeps its contacts: no margin) */
+        double margin = *correct ? 1.0 : r->opt.autoscale_margin;
+        double factor = margin * r->tau / m.thickness;
         tk_curve_scale(*curve, factor);
         /* A radius far from the curve's own scale can carry it out of the
          * range the engine measures in. */
@@ -450,11 +472,19 @@ static int prepare_curve(tk_run *r, const tk_curve *start, tk_error *err)
     return TK_OK;
 }
 
+/* Newton steps on a resampled curve's violated constraints (resample_to) */
+static int correct_resampled(tk_run *r, tk_error *err);
+
 int tk_schedule_start(tk_run *r, const tk_curve *start, tk_error *err)
 {
     r->schedule.resolved_at = INFINITY;
-    int rc = prepare_curve(r, start, err);
-    return rc ? rc : tk_schedule_fit(r, err);
+    bool correct = false;
+    int rc = prepare_curve(r, start, &correct, err);
+    if (!rc)
+        rc = tk_schedule_fit(r, err);
+    if (!rc && correct)
+        rc = correct_resampled(r, err);
+    return rc;
 }
 
 int tk_schedule_resume(tk_run *r, const tk_curve *curve, const tk_resume *at, tk_error *err)
@@ -526,6 +556,21 @@ void tk_schedule_resume_point(const tk_run *r, tk_resume *out)
  * take RESAMPLED_CORRECTIONS steps. */
 #define RESAMPLED_RESCALE_UP_TO 0.5
 #define RESAMPLED_CORRECTIONS 400
+static int correct_resampled(tk_run *r, tk_error *err)
+{
+    double worst = 0.0;
+    int rc = tk_recovery_violation(r, r->shared.curve, &worst, err);
+    if (rc || !(worst > tk_tolerance_correction(r)))
+        return rc;
+    int iterations = 0;
+    tk_error why;
+    rc = tk_recovery_correct(r, RESAMPLED_CORRECTIONS, RESAMPLED_RESCALE_UP_TO, &iterations, &why);
+    if (rc)
+        return tk_error_set(err, rc, "resampling to %zu vertices: %s", r->shared.curve->nvert,
+                            why.message);
+    return TK_OK;
+}
+
 static int resample_to(tk_run *r, size_t count, tk_error *err)
 {
     tk_curve *resampled = NULL;
@@ -541,20 +586,10 @@ static int resample_to(tk_run *r, size_t count, tk_error *err)
     r->schedule.polish_from = r->schedule.polish_began = r->life.nhistory;
     r->schedule.resampled_from = r->life.nhistory;
     rc = tk_schedule_fit(r, err);
-    double worst = 0.0;
     if (!rc)
-        rc = tk_recovery_violation(r, r->shared.curve, &worst, err);
+        rc = correct_resampled(r, err);
     if (rc)
         return rc;
-    if (worst > tk_tolerance_correction(r)) {
-        int iterations = 0;
-        tk_error why;
-        rc = tk_recovery_correct(r, RESAMPLED_CORRECTIONS, RESAMPLED_RESCALE_UP_TO, &iterations,
-                                 &why);
-        if (rc)
-            return tk_error_set(err, rc, "resampling to %zu vertices: %s",
-                                r->shared.curve->nvert, why.message);
-    }
     tk_stepping_reset(r);
     char when[64];
     snprintf(when, sizeof when, "resampling to %zu vertices", r->shared.curve->nvert);

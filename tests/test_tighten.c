@@ -980,6 +980,50 @@ START_TEST(a_tight_curve_tightened_again_steps_at_a_bounded_cost)
 }
 END_TEST
 
+START_TEST(a_tight_start_refined_and_autoscaled_keeps_its_contacts)
+{
+    /* tests/data/trefoil-600.vect (a tight trefoil, 32.7460111) started
+     * at 1,200 vertices on its final polygon, autoscaled: the spline
+     * through it cuts the tube where it bends at the curvature bound.
+     * Scaled to the tube by the spline's thickness it was 7% loose
+     * (35.03) and kept no contact; the start must instead be the polygon at the tube,
+     * resampled, its few violations put back by Newton steps. */
+    tk_curve *c = test_data("trefoil-600.vect");
+    tk_error err;
+    tk_measure given, spline;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &given, NULL), TK_OK);
+    tk_curve *fine = NULL;
+    ck_assert_int_eq(tk_curve_resample_total(c, 1200, &fine, &err), TK_OK);
+    ck_assert_int_eq(tk_thickness_measure(fine, NULL, &spline, NULL), TK_OK);
+    tk_curve_free(&fine);
+    /* (what scaling by the spline's thickness would start from) */
+    double scaled = 2.0 * spline.length / spline.thickness;
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.coarse_to_fine = false;
+    o.escapes = 0;
+    o.vertices = 1200;
+    tk_run *run = NULL;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(tk_run_curve(run), NULL, &m, NULL), TK_OK);
+    const tk_step_report *s = tk_run_latest(run);
+    printf("tight trefoil 600 -> 1200: start %.7f with %zu struts (given %.7f; the spline "
+           "scaled, %.7f)\n", m.ropelength, s->struts, given.ropelength, scaled);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, 1200);
+    ck_assert_msg(scaled > given.ropelength * 1.01, "the spline only %.7f", scaled);
+    /* feasible within the correction tolerance, and in place */
+    ck_assert_msg(m.thickness >= 1.0 - 3e-5, "thickness %.9f", m.thickness);
+    ck_assert_msg(m.minrad >= 0.5 * (1.0 - 3e-5), "minrad %.9f", m.minrad);
+    ck_assert_msg(fabs(m.ropelength / given.ropelength - 1.0) < 1e-3, "%.7f from %.7f",
+                  m.ropelength, given.ropelength);
+    /* (155 at the start's tolerance; scaled, none) */
+    ck_assert_uint_ge(s->struts, 100);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(a_refined_tight_polygon_is_restored_without_rescaling)
 {
     if (quick() && tkt_skip("a_refined_tight_polygon_is_restored_without_rescaling", LONG_RUN))
@@ -3054,6 +3098,7 @@ int main(void)
     tcase_add_test(tc, recovery_restores_thousands_of_contacts_without_rescaling);
     tcase_add_test(tc, a_fine_start_is_set_up_with_the_tolerance_of_its_edges);
     tcase_add_test(tc, a_fine_tight_polygon_is_restored_in_place);
+    tcase_add_test(tc, a_tight_start_refined_and_autoscaled_keeps_its_contacts);
     tcase_add_test(tc, a_tight_curve_tightened_again_steps_at_a_bounded_cost);
     tcase_add_test(tc, a_fine_tight_curve_polishes_at_the_rate_of_its_fall);
     tcase_add_test(tc, polishing_stops_at_the_third_level_where_the_edge_sets_the_tolerance);
