@@ -435,24 +435,21 @@ static int prepare_curve(tk_run *r, const tk_curve *start, bool *correct, tk_err
          * thinner than its polygon, is one the spline cuts where it bends
          * at the curvature bound or between contacts: a tight curve.
          * Scaled to the tube by the spline's thickness it loses every
-         * contact (catalogue 3.1 tightened at 4,800 vertices, 32.74300,
-         * resampled to 9,600 was 3.5% loose, and took 1,944 s to come
-         * back to 32.7506); scaled by its polygon's, the few vertices that
-         * cut the tube are put back by Newton steps, as a run's own
-         * refinement does (resample_to).  Spline resampling commutes with
-         * scaling, so this is the polygon scaled, then resampled.  Only
-         * for a start put on its final polygon: a coarse level's flow
-         * tightens a looser start anyway, at a fraction of the cost. */
-        if (r->opt.autoscale && (*curve)->nvert > given && m.thickness < start_thickness &&
-            r->schedule.coarse_level == 0) {
-            m.thickness = start_thickness;
-            *correct = true;
-        }
+         * contact (catalogue 3.1 tightened at 4,800 vertices, 32.7429968,
+         * resampled to 9,600 was 3.5% loose, and 1,944 s later still at
+         * 32.7506); scaled by its polygon's, with no margin, the few
+         * vertices that cut the tube are put back by Newton steps, as a
+         * run's own refinement does (correct_resampled).  Spline
+         * resampling commutes with scaling, so this is the polygon
+         * scaled, then resampled.  Only for a start put on its final
+         * polygon: a coarse level's flow tightens a looser start anyway,
+         * at a fraction of the cost. */
+        *correct = r->opt.autoscale && (*curve)->nvert > given &&
+                   m.thickness < start_thickness && r->schedule.coarse_level == 0;
     }
     if (r->opt.autoscale) {
-        /* (a curve to be corrected keeps its contacts: no margin) */
-        double margin = *correct ? 1.0 : r->opt.autoscale_margin;
-        double factor = margin * r->tau / m.thickness;
+        double factor = *correct ? r->tau / start_thickness
+                                 : r->opt.autoscale_margin * r->tau / m.thickness;
         tk_curve_scale(*curve, factor);
         /* A radius far from the curve's own scale can carry it out of the
          * range the engine measures in. */

@@ -986,8 +986,9 @@ START_TEST(a_tight_start_refined_and_autoscaled_keeps_its_contacts)
      * at 1,200 vertices on its final polygon, autoscaled: the spline
      * through it cuts the tube where it bends at the curvature bound.
      * Scaled to the tube by the spline's thickness it was 7% loose
-     * (35.03) and kept no contact; the start must instead be the polygon at the tube,
-     * resampled, its few violations put back by Newton steps. */
+     * (35.03) and kept no contact; the start must instead be the polygon
+     * at the tube, resampled, its few violations put back by Newton
+     * steps. */
     tk_curve *c = test_data("trefoil-600.vect");
     tk_error err;
     tk_measure given, spline;
