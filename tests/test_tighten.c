@@ -1025,6 +1025,42 @@ START_TEST(a_tight_start_refined_and_autoscaled_keeps_its_contacts)
 }
 END_TEST
 
+START_TEST(a_tight_start_refined_sixteen_times_over_keeps_its_place)
+{
+    if (quick() && tkt_skip("a_tight_start_refined_sixteen_times_over_keeps_its_place",
+                            LONG_RUN))
+        return;
+    /* The same trefoil started at 9,600 vertices: resampled to them at
+     * once, the spline's violations were so many and the Newton steps on
+     * them so stiff that 400 steps did not put them back, and the start
+     * was scaled up to 34.05 (4% loose).  A polygon resampled from a
+     * tight one is within 0.1% of its ropelength (the 1,200-vertex start
+     * above: 0.003%); so must this start be, and feasible. */
+    tk_curve *c = test_data("trefoil-600.vect");
+    tk_error err;
+    tk_measure given;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, &given, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.coarse_to_fine = false;
+    o.escapes = 0;
+    o.vertices = 9600;
+    tk_run *run = NULL;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(tk_run_curve(run), NULL, &m, NULL), TK_OK);
+    printf("tight trefoil 600 -> 9600: start %.7f (given %.7f)\n", m.ropelength,
+           given.ropelength);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, 9600);
+    ck_assert_msg(m.thickness >= 1.0 - 3e-5, "thickness %.9f", m.thickness);
+    ck_assert_msg(m.minrad >= 0.5 * (1.0 - 3e-5), "minrad %.9f", m.minrad);
+    ck_assert_msg(fabs(m.ropelength / given.ropelength - 1.0) < 1e-3, "%.7f from %.7f",
+                  m.ropelength, given.ropelength);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(a_refined_tight_polygon_is_restored_without_rescaling)
 {
     if (quick() && tkt_skip("a_refined_tight_polygon_is_restored_without_rescaling", LONG_RUN))
@@ -3100,6 +3136,7 @@ int main(void)
     tcase_add_test(tc, a_fine_start_is_set_up_with_the_tolerance_of_its_edges);
     tcase_add_test(tc, a_fine_tight_polygon_is_restored_in_place);
     tcase_add_test(tc, a_tight_start_refined_and_autoscaled_keeps_its_contacts);
+    tcase_add_test(tc, a_tight_start_refined_sixteen_times_over_keeps_its_place);
     tcase_add_test(tc, a_tight_curve_tightened_again_steps_at_a_bounded_cost);
     tcase_add_test(tc, a_fine_tight_curve_polishes_at_the_rate_of_its_fall);
     tcase_add_test(tc, polishing_stops_at_the_third_level_where_the_edge_sets_the_tolerance);
