@@ -980,6 +980,33 @@ START_TEST(a_tight_curve_tightened_again_steps_at_a_bounded_cost)
 }
 END_TEST
 
+/* tests/data/trefoil-600.vect (a tight trefoil) started at `vertices` on
+ * its final polygon, autoscaled, with no escape; *given is the file's
+ * measure, *m the run's start's.  The start must be at the tube (within
+ * the correction tolerance) and in place: within 0.1% of the given
+ * ropelength, as a polygon resampled from a tight one is. */
+static tk_run *refined_trefoil(size_t vertices, tk_measure *given, tk_measure *m)
+{
+    tk_curve *c = test_data("trefoil-600.vect");
+    tk_error err;
+    ck_assert_int_eq(tk_thickness_measure(c, NULL, given, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.coarse_to_fine = false;
+    o.escapes = 0;
+    o.vertices = vertices;
+    tk_run *run = NULL;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    tk_curve_free(&c);
+    ck_assert_int_eq(tk_thickness_measure(tk_run_curve(run), NULL, m, NULL), TK_OK);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, vertices);
+    ck_assert_msg(m->thickness >= 1.0 - 3e-5, "thickness %.9f", m->thickness);
+    ck_assert_msg(m->minrad >= 0.5 * (1.0 - 3e-5), "minrad %.9f", m->minrad);
+    ck_assert_msg(fabs(m->ropelength / given->ropelength - 1.0) < 1e-3, "%.7f from %.7f",
+                  m->ropelength, given->ropelength);
+    return run;
+}
+
 START_TEST(a_tight_start_refined_and_autoscaled_keeps_its_contacts)
 {
     /* tests/data/trefoil-600.vect (a tight trefoil, 32.7460111) started
@@ -991,37 +1018,23 @@ START_TEST(a_tight_start_refined_and_autoscaled_keeps_its_contacts)
      * steps. */
     tk_curve *c = test_data("trefoil-600.vect");
     tk_error err;
-    tk_measure given, spline;
-    ck_assert_int_eq(tk_thickness_measure(c, NULL, &given, NULL), TK_OK);
+    tk_measure spline;
     tk_curve *fine = NULL;
     ck_assert_int_eq(tk_curve_resample_total(c, 1200, &fine, &err), TK_OK);
     ck_assert_int_eq(tk_thickness_measure(fine, NULL, &spline, NULL), TK_OK);
     tk_curve_free(&fine);
+    tk_curve_free(&c);
     /* (what scaling by the spline's thickness would start from) */
     double scaled = 2.0 * spline.length / spline.thickness;
-    tk_options o = TK_OPTIONS_INIT;
-    o.autoscale = true;
-    o.coarse_to_fine = false;
-    o.escapes = 0;
-    o.vertices = 1200;
-    tk_run *run = NULL;
-    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
-    tk_measure m;
-    ck_assert_int_eq(tk_thickness_measure(tk_run_curve(run), NULL, &m, NULL), TK_OK);
+    tk_measure given, m;
+    tk_run *run = refined_trefoil(1200, &given, &m);
     const tk_step_report *s = tk_run_latest(run);
     printf("tight trefoil 600 -> 1200: start %.7f with %zu struts (given %.7f; the spline "
            "scaled, %.7f)\n", m.ropelength, s->struts, given.ropelength, scaled);
-    ck_assert_uint_eq(tk_run_curve(run)->nvert, 1200);
     ck_assert_msg(scaled > given.ropelength * 1.01, "the spline only %.7f", scaled);
-    /* feasible within the correction tolerance, and in place */
-    ck_assert_msg(m.thickness >= 1.0 - 3e-5, "thickness %.9f", m.thickness);
-    ck_assert_msg(m.minrad >= 0.5 * (1.0 - 3e-5), "minrad %.9f", m.minrad);
-    ck_assert_msg(fabs(m.ropelength / given.ropelength - 1.0) < 1e-3, "%.7f from %.7f",
-                  m.ropelength, given.ropelength);
     /* (155 at the start's tolerance; scaled, none) */
     ck_assert_uint_ge(s->struts, 100);
     tk_run_free(&run);
-    tk_curve_free(&c);
 }
 END_TEST
 
@@ -1036,28 +1049,11 @@ START_TEST(a_tight_start_refined_sixteen_times_over_keeps_its_place)
      * was scaled up to 34.05 (4% loose).  A polygon resampled from a
      * tight one is within 0.1% of its ropelength (the 1,200-vertex start
      * above: 0.003%); so must this start be, and feasible. */
-    tk_curve *c = test_data("trefoil-600.vect");
-    tk_error err;
-    tk_measure given;
-    ck_assert_int_eq(tk_thickness_measure(c, NULL, &given, NULL), TK_OK);
-    tk_options o = TK_OPTIONS_INIT;
-    o.autoscale = true;
-    o.coarse_to_fine = false;
-    o.escapes = 0;
-    o.vertices = 9600;
-    tk_run *run = NULL;
-    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
-    tk_measure m;
-    ck_assert_int_eq(tk_thickness_measure(tk_run_curve(run), NULL, &m, NULL), TK_OK);
+    tk_measure given, m;
+    tk_run *run = refined_trefoil(9600, &given, &m);
     printf("tight trefoil 600 -> 9600: start %.7f (given %.7f)\n", m.ropelength,
            given.ropelength);
-    ck_assert_uint_eq(tk_run_curve(run)->nvert, 9600);
-    ck_assert_msg(m.thickness >= 1.0 - 3e-5, "thickness %.9f", m.thickness);
-    ck_assert_msg(m.minrad >= 0.5 * (1.0 - 3e-5), "minrad %.9f", m.minrad);
-    ck_assert_msg(fabs(m.ropelength / given.ropelength - 1.0) < 1e-3, "%.7f from %.7f",
-                  m.ropelength, given.ropelength);
     tk_run_free(&run);
-    tk_curve_free(&c);
 }
 END_TEST
 
