@@ -29,7 +29,8 @@
  * 3e-3); a curve critical at its tolerance goes no further at it. */
 #define POLISH_CRITICAL 1e-3
 #define POLISH_CRITICAL_STEPS 20
-/* On the final polygon, where the window (below) is at least
+/* On the final polygon and the coarse levels above the coarsest, where
+ * the window (below) is at least
  * POLISH_RATE_FROM times POLISH_WINDOW steps, a level also ends when the
  * fall over its last POLISH_WINDOW steps, at that rate over the whole
  * window, is below the bound.  The window is 2,933 steps at 2,400
@@ -42,10 +43,24 @@
  * 32.743705 and 32.743714 (two runs; 52 and 66 ms a step from step 600)
  * against 32.743787; catalogue 3.1 at `--vertices 2400` for 600 s
  * reached 32.7432766 against 32.7436118 (9,005 steps on the final
- * polygon against 942).  Not on the coarse levels: there a level that
- * stalls moves on to the next polygon, and the same run left them at
- * 22 s instead of 154 s, looser, and ended at 32.74377.  The atlas's
- * counts (200 to 600 vertices, windows of 320 to 380 steps) keep the
+ * polygon against 942).  Not on the coarsest level nor the loose ones
+ * below it: a loose descent crawls there past saddles more cheaply than
+ * on any finer polygon, and with the rate on every coarse level the same
+ * run left them at 22 s instead of 154 s, looser, and ended at 32.74377.
+ * A level above the coarsest starts from a curve settled on the polygon
+ * half as fine (with escapes, polished by the tries judged on the
+ * coarsest) and takes up the finer polygon's share of the ropelength in
+ * its first steps; after that its crawl is worth less than the next
+ * polygon's steps.  Catalogue 3.1 at `--vertices 4800` (600 s of
+ * processor time) stayed 114 s on its 1,200-vertex level at 0.3 s a
+ * step (4,100 struts) while its ropelength fell by 1e-7 (relative) in
+ * 250 steps, reached 4,800 vertices with 74 s left and ended at
+ * 32.7430069; with the rate there it left that level after 65 s and the
+ * 2,400-vertex one after 8, passed 32.74300 at 517 s and ended at
+ * 32.7429952.  At `--vertices 2400`: 32.7431042 against 32.7431058, on
+ * the final polygon from 191 s instead of 247 s.  The atlas's counts
+ * (200 to 600 vertices, windows of 320 to 380 steps) and the coarse
+ * levels of resolutions below 20 (windows below 400 steps) keep the
  * whole window. */
 #define POLISH_RATE_FROM 2
 /* The windows of steps that judge whether the ropelength has stopped
@@ -962,7 +977,9 @@ static bool stalled(const tk_run *r)
     double fall, bound = POLISH_CHANGE * tk_polish_scale(r);
     if (tk_history_fall(r, from, window, &fall) && fall < bound)
         return true;
-    return tk_schedule_final(r) && window >= POLISH_RATE_FROM * POLISH_WINDOW &&
+    bool above_coarsest =
+        tk_schedule_final(r) || r->schedule.coarse_level < r->schedule.coarse_levels;
+    return above_coarsest && window >= POLISH_RATE_FROM * POLISH_WINDOW &&
            tk_history_fall(r, from, POLISH_WINDOW, &fall) &&
            fall * (double)window / POLISH_WINDOW < bound;
 }

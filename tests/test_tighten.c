@@ -2376,10 +2376,15 @@ static size_t window_at(const tk_step_report *h, size_t i)
  * the options' 3e-4).  A level that begins at step i's watch starts its
  * window at report i; a move-on shows as report i + 1's count or
  * restarts.  Polished, it also moves on `cap` steps (0: none) after its
- * first stall.  The report where it moved on, or 0 if it did not. */
+ * first stall.  A level above the coarsest (`above`) whose window is 400
+ * steps or more also stalls when its fall over the last 200 steps, at
+ * that rate over the whole window, is below the bound.  The report where
+ * it moved on, or 0 if it did not; *by_rate tells whether that rate was
+ * what moved it (the fall over the whole window was not yet below). */
 static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t from, bool polished,
-                                   double cap, size_t *first_stall)
+                                   bool above, double cap, size_t *first_stall, bool *by_rate)
 {
+    *by_rate = false;
     int level = 0;
     *first_stall = 0;
     for (size_t i = from + 1; i + 1 < nh; i++) {
@@ -2387,7 +2392,11 @@ static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t fr
         bool critical = i >= from + 20; /* (the watch's rule on every level) */
         for (size_t k = i >= 20 ? i - 20 : 0; k < i && critical; k++)
             critical = h[k].residual < 1e-3;
-        bool stall = fall_over(h, from, i, window) < 1e-4 * pow(1.0 / 3.0, level) || critical;
+        double bound = 1e-4 * pow(1.0 / 3.0, level);
+        bool slow = fall_over(h, from, i, window) < bound;
+        bool rate = above && window >= 400 &&
+                    fall_over(h, from, i, 200) * (double)window / 200.0 < bound;
+        bool stall = slow || rate || critical;
         bool moved = h[i + 1].vertices != h[i].vertices || h[i + 1].restarts != h[i].restarts;
         /* (a level where tries are judged is also left `cap` steps after
          * its first stall: the watch at report i's step sees report i - 1,
@@ -2398,8 +2407,10 @@ static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t fr
                       "step %ld at level %d (since report %zu): %s, %s", h[i].step, level, from,
                       stall ? "stalled" : capped ? "capped" : "going on",
                       moved ? "moved on" : "stayed");
-        if (moved)
+        if (moved) {
+            *by_rate = rate && !slow && !critical;
             return i;
+        }
         if (stall) {
             *first_stall = *first_stall ? *first_stall : i;
             level++;
@@ -2451,10 +2462,11 @@ START_TEST(a_fine_coarse_level_waits_as_many_more_steps)
         ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
     ck_assert_uint_eq(tk_run_curve(run)->nvert, o.vertices);
     size_t nh = 0, from = 0, levels = 0, stall = 0, i;
+    bool by_rate = false;
     const tk_step_report *h = tk_run_history(run, &nh);
     double most = 1.0;
     /* every level, the final one too (which does not move on) */
-    while ((i = coarse_level_checked(h, nh, from, false, 0.0, &stall)) > 0) {
+    while ((i = coarse_level_checked(h, nh, from, false, levels > 0, 0.0, &stall, &by_rate)) > 0) {
         size_t window = window_at(h, i);
         printf("T(2,3) at 600: the %zu-vertex level moved on at step %ld after %zu steps "
                "(window %zu), ropelength %.5f\n",
@@ -2466,6 +2478,55 @@ START_TEST(a_fine_coarse_level_waits_as_many_more_steps)
     }
     ck_assert_uint_eq(levels, 3);
     ck_assert_double_ge(most, 1.5); /* the rule in steps alone would differ */
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
+/* Above the coarsest level, a level whose window is 400 steps or more
+ * (a mean edge of a twentieth of the diameter or less) also moves on when
+ * its fall over the last 200 steps, at that rate over the whole window,
+ * is below the bound, as the final polygon's polishing does
+ * (POLISH_RATE_FROM, schedule.c).  The trefoil from the round torus at
+ * 1,600 vertices goes through coarse levels of 200, 400 and 800 vertices
+ * (41.8 a unit, three halvings at most), the last two with windows of
+ * about 480 and 960 steps; each level ends exactly where the rules first
+ * hold, and at least one where the rate alone holds. */
+START_TEST(a_coarse_level_above_the_coarsest_moves_on_at_the_final_rate)
+{
+    if (quick() && tkt_skip("a_coarse_level_above_the_coarsest_moves_on_at_the_final_rate",
+                            LONG_RUN))
+        return;
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 200, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.vertices = 1600;
+    o.escapes = 0;
+    o.loose = 0;
+    o.max_steps = 1000000; /* too large for any level's share to end it */
+    tk_run *run = NULL;
+    tk_error err;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, 200);
+    while (tk_run_curve(run)->nvert < o.vertices && tk_run_latest(run)->step < 40000)
+        ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, o.vertices);
+    size_t nh = 0, from = 0, levels = 0, rated = 0, stall = 0, i;
+    bool by_rate = false;
+    const tk_step_report *h = tk_run_history(run, &nh);
+    while ((i = coarse_level_checked(h, nh, from, false, levels > 0, 0.0, &stall, &by_rate)) > 0) {
+        printf("T(2,3) at 1600: the %zu-vertex level moved on at step %ld after %zu steps "
+               "(window %zu)%s, ropelength %.6f\n",
+               h[i].vertices, h[i].step, i + 1 - from, window_at(h, i),
+               by_rate ? " at the final rate" : "", h[i].ropelength);
+        ck_assert_uint_eq(h[i + 1].vertices, 2 * h[i].vertices);
+        rated += by_rate;
+        from = i + 1;
+        levels++;
+    }
+    ck_assert_uint_eq(levels, 3);
+    ck_assert_uint_ge(rated, 1);
     tk_run_free(&run);
     tk_curve_free(&c);
 }
@@ -2493,12 +2554,14 @@ static long polished_try(long steps)
         h = tk_run_history(run, &nh);
     }
     size_t stall = 0;
-    size_t first = coarse_level_checked(h, nh, 0, false, 0.0, &stall);
+    bool by_rate = false;
+    size_t first = coarse_level_checked(h, nh, 0, false, false, 0.0, &stall, &by_rate);
     ck_assert_uint_gt(first, 0);
     size_t ne = 0;
     const tk_escape *e = tk_run_escapes(run, &ne);
     ck_assert(ne == 1 && e[0].explored && h[first + 1].escapes == 1);
-    size_t tried = coarse_level_checked(h, nh, first + 1, true, 0.05 * (double)steps, &stall);
+    size_t tried = coarse_level_checked(h, nh, first + 1, true, false, 0.05 * (double)steps,
+                                        &stall, &by_rate);
     ck_assert_uint_gt(tried, 0);
     ck_assert(e[0].coarse == h[tried].ropelength);
     long spent = h[tried].step - h[stall].step;
@@ -3145,6 +3208,7 @@ int main(void)
     tcase_add_test(tc, a_loose_try_starts_on_its_own_count);
     tcase_add_test(tc, a_loose_start_at_a_vertex_count_escapes_coarse);
     tcase_add_test(tc, a_fine_coarse_level_waits_as_many_more_steps);
+    tcase_add_test(tc, a_coarse_level_above_the_coarsest_moves_on_at_the_final_rate);
     tcase_add_test(tc, the_coarsest_level_of_a_try_is_polished_first);
     tcase_add_test(tc, a_try_leaves_its_coarsest_level_after_a_twentieth_of_the_budget);
     tcase_add_test(tc, unknot_and_unlink_are_handled);
