@@ -2421,23 +2421,24 @@ static size_t coarse_level_checked(const tk_step_report *h, size_t nh, size_t fr
 }
 
 /* The trefoil from the round torus (200 vertices) set up to be tightened
- * at 600 vertices, coarse to fine from 75 (600 / 38.3 is 15.7 a unit,
- * whose third halving, 1.96, is the one nearest 2.5), with a budget of
- * `steps`
- * (1,000,000: too large for any level's share to end it). */
-static tk_run *torus_trefoil_at_600(int escapes, long steps, tk_curve **c, tk_options *o)
+ * at `vertices`, coarse to fine from `coarsest` (600 / 38.3 is 15.7 a
+ * unit, whose third halving, 1.96, is the one nearest 2.5: 75), with a
+ * budget of `steps` (1,000,000: too large for any level's share to end
+ * it). */
+static tk_run *torus_trefoil_at(size_t vertices, size_t coarsest, int escapes, long steps,
+                                tk_curve **c, tk_options *o)
 {
     ck_assert_int_eq(tk_generate_torus(2, 3, 200, c, NULL), TK_OK);
     *o = (tk_options)TK_OPTIONS_INIT;
     o->autoscale = true;
-    o->vertices = 600;
+    o->vertices = vertices;
     o->escapes = escapes;
     o->loose = 0; /* the coarse levels alone */
     o->max_steps = steps;
     tk_run *run = NULL;
     tk_error err;
     ck_assert_int_eq(tk_run_new(*c, o, &run, &err), TK_OK);
-    ck_assert_uint_eq(tk_run_curve(run)->nvert, 75);
+    ck_assert_uint_eq(tk_run_curve(run)->nvert, coarsest);
     return run;
 }
 
@@ -2456,7 +2457,7 @@ START_TEST(a_fine_coarse_level_waits_as_many_more_steps)
         return;
     tk_curve *c = NULL;
     tk_options o;
-    tk_run *run = torus_trefoil_at_600(0, 1000000, &c, &o);
+    tk_run *run = torus_trefoil_at(600, 75, 0, 1000000, &c, &o);
     tk_error err;
     while (tk_run_curve(run)->nvert < o.vertices && tk_run_latest(run)->step < 20000)
         ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
@@ -2498,17 +2499,9 @@ START_TEST(a_coarse_level_above_the_coarsest_moves_on_at_the_final_rate)
                             LONG_RUN))
         return;
     tk_curve *c = NULL;
-    ck_assert_int_eq(tk_generate_torus(2, 3, 200, &c, NULL), TK_OK);
-    tk_options o = TK_OPTIONS_INIT;
-    o.autoscale = true;
-    o.vertices = 1600;
-    o.escapes = 0;
-    o.loose = 0;
-    o.max_steps = 1000000; /* too large for any level's share to end it */
-    tk_run *run = NULL;
+    tk_options o;
+    tk_run *run = torus_trefoil_at(1600, 200, 0, 1000000, &c, &o);
     tk_error err;
-    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_OK);
-    ck_assert_uint_eq(tk_run_curve(run)->nvert, 200);
     while (tk_run_curve(run)->nvert < o.vertices && tk_run_latest(run)->step < 40000)
         ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
     ck_assert_uint_eq(tk_run_curve(run)->nvert, o.vertices);
@@ -2543,7 +2536,7 @@ static long polished_try(long steps)
 {
     tk_curve *c = NULL;
     tk_options o;
-    tk_run *run = torus_trefoil_at_600(1, steps, &c, &o);
+    tk_run *run = torus_trefoil_at(600, 75, 1, steps, &c, &o);
     tk_error err;
     size_t nh = 0;
     const tk_step_report *h = tk_run_history(run, &nh);
