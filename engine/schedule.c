@@ -152,6 +152,17 @@
  * spline through a polygon with a spike loops through the polygon (a
  * 16-gon with one vertex pulled out: ropelength 48, resampled 1e17). */
 #define START_ROPELENGTH_MAX 1e9
+/* The smallest an autoscaled run starts from: a rope shorter than its
+ * own diameter.  Only an open rope gets there (a closed curve's
+ * ropelength is at least 2 pi), and only when it is (nearly) straight, so
+ * that its thickness is set by the turning at a vertex, and there by
+ * rounding when the vertices are collinear: autoscaled, such a rope
+ * shrinks to the size of the rounding and the next rounding moves its
+ * thickness anywhere (four collinear vertices, scaled by 1e-16 to a
+ * thickness 1.002, measured 0.405 after a step of size 0).  At its own
+ * scale a straight rope is a tight one (pulled straight between two
+ * planes) and runs. */
+#define AUTOSCALE_ROPELENGTH_MIN 2.0
 
 size_t tk_schedule_window(const tk_run *r, size_t steps)
 {
@@ -416,6 +427,13 @@ static int prepare_curve(tk_run *r, const tk_curve *start, bool *correct, tk_err
                             "the curve is too thin for its length to tighten in double "
                             "precision: ropelength %.6g, above %g (does it nearly cross itself?)",
                             m.ropelength, START_ROPELENGTH_MAX);
+    if (r->opt.autoscale && !(m.ropelength >= AUTOSCALE_ROPELENGTH_MIN))
+        return tk_error_set(err, TK_EINVAL,
+                            "autoscale cannot size this rope: it is shorter than its own "
+                            "tube's diameter (ropelength %.6g, below %g), its thickness set "
+                            "by a (nearly) straight turn; tighten it at its own scale, "
+                            "without autoscale",
+                            m.ropelength, AUTOSCALE_ROPELENGTH_MIN);
     if (resolution_final(r) > 0.0) {
         double want = (double)level_count(r, r->schedule.start_ropelength);
         if (want > TK_RUN_MAX_VERTICES)

@@ -1327,6 +1327,55 @@ START_TEST(resampling_that_crosses_the_curve_is_refused)
 }
 END_TEST
 
+START_TEST(an_autoscaled_rope_shorter_than_its_diameter_is_refused)
+{
+    /* Four vertices of an open rope on a line but for a rounding (as
+     * settling its ends on planes left them): its thickness is set by the
+     * turning at a vertex, that is by rounding, about 1e16 times its
+     * length.  Autoscaled, it once shrank to a length of 1.3e-16, and a
+     * step of size 0 took its thickness from 1.002 to 0.405 of the
+     * diameter.  (Exactly on the line, its thickness is infinite and it
+     * is refused for that.) */
+    size_t n = 4;
+    bool closed = false;
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_curve_new(&c, 1, &n, &closed, NULL), TK_OK);
+    const double along[] = {0.0, 2.0 / 4096, 1.0, 14000.0 / 4096};
+    for (size_t i = 0; i < n; i++)
+        tk_curve_vertex(c, i)[0] = along[i];
+    tk_curve_vertex(c, 1)[1] = 1e-19;
+    tk_options o = TK_OPTIONS_INIT;
+    o.max_steps = 3;
+    tk_run *run = NULL;
+    tk_error err;
+    o.autoscale = true;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, &err), TK_EINVAL);
+    ck_assert_msg(strstr(err.message, "shorter than its own tube's diameter"), "%s", err.message);
+    ck_assert(run == NULL);
+    /* At its own scale it runs (a rope pulled straight between two planes
+     * is a tight one, tests/cli-tighten.sh), its thickness held. */
+    o.autoscale = false;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    tk_stop_reason why;
+    ck_assert_msg(tk_run_until(run, &why, &err) == TK_OK, "%s", err.message);
+    ck_assert(tk_run_latest(run)->thickness >= 1.0 * (1 - o.overstep_tolerance));
+    tk_run_free(&run);
+    /* Bent by a right angle at its third vertex, the same rope has its
+     * thickness from that turn (a ropelength about 7): autoscaled, it runs
+     * with its thickness held. */
+    double *v = tk_curve_vertex(c, 3);
+    v[0] = 1.0;
+    v[1] = 14000.0 / 4096 - 1.0;
+    o.autoscale = true;
+    ck_assert_msg(tk_run_new(c, &o, &run, &err) == TK_OK, "%s", err.message);
+    ck_assert_msg(tk_run_until(run, &why, &err) == TK_OK, "%s", err.message);
+    ck_assert_msg(tk_run_latest(run)->ropelength >= 2.0, "%.17g", tk_run_latest(run)->ropelength);
+    ck_assert(tk_run_latest(run)->thickness >= 1.0 * (1 - o.overstep_tolerance));
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 typedef struct cancel_case {
     tk_run *run;
     long steps_at_cancel;
@@ -3216,6 +3265,7 @@ int main(void)
     tcase_set_timeout(range, 30);
     tcase_add_test(range, radius_out_of_the_range_is_refused);
     tcase_add_test(range, resampling_that_crosses_the_curve_is_refused);
+    tcase_add_test(range, an_autoscaled_rope_shorter_than_its_diameter_is_refused);
     suite_add_tcase(s, range);
     return tkt_run_suite(s);
 }
