@@ -134,8 +134,10 @@ END_TEST
 /* The parametric figure-eight ((2 + cos 2t) cos 3t, (2 + cos 2t) sin 3t,
  * sin 4t) keeps its symmetry under the flow and, on its coarse level
  * alone, stops far from tight, kinked: with no loose levels and no
- * escapes the run ends there.  The defaults (loose levels first, then
- * escapes) must reach the tight one.  (The catalogue's 4.1 and the
+ * escapes the run stays there (55.1699 after 3,000 steps, 55.1073 after
+ * 15,000, against 42.097: the 12,000 steps between, 150 s, are left
+ * out).  The defaults (loose levels first, then escapes) must reach the
+ * tight one.  (The catalogue's 4.1 and the
  * disguised copies reach it too, in bench/starts; at 10 ms a step at this
  * count they are left to it.) */
 START_TEST(a_symmetric_figure_eight_reaches_the_tight_one)
@@ -147,7 +149,7 @@ START_TEST(a_symmetric_figure_eight_reaches_the_tight_one)
     tk_options o = TK_OPTIONS_INIT;
     o.autoscale = true;
     o.vertices = 280;
-    o.max_steps = 15000;
+    o.max_steps = 3000;
     o.loose = 0;
     o.escapes = 0;
     tk_run *run = NULL;
