@@ -60,16 +60,16 @@ run_unit() {
     echo "counts: $((checks - bad - skips)) $bad $skips"
 }
 
-# Runs $2 (run_unit or run_suite) on each of the list $1 in $4 lanes
-# (default 2, one a core): each lane takes the next not yet taken (mkdir
-# is the lock), so a list ordered longest first has its lanes end
-# together.  Each one's output goes to a file of its own; they are printed
-# in the list's order at the end and their counts added to the totals.
-# $3 names the lanes' directory when one function runs twice.
+# Runs $2 (run_unit or run_suite) on each of the list $1 in two lanes, one
+# a core: each lane takes the next not yet taken (mkdir is the lock), so
+# a list ordered longest first has its lanes end together.  Each one's
+# output goes to a file of its own; they are printed in the list's order
+# at the end and their counts added to the totals.  $3 names the lanes'
+# directory when one function runs twice.
 in_lanes() {
     lanedir=$lanes/${3:-$2}
     mkdir "$lanedir"
-    for _ in $(seq "${4:-2}"); do
+    for _ in 1 2; do
         (
             i=0
             for t in $1; do
@@ -194,7 +194,7 @@ if [ "$unit_only" -eq 0 ]; then
     for t in tests/cli-*.sh tests/*/run.sh; do
         case " $suites " in *" $t "*) ;; *) [ "$t" = tests/fuzz/run.sh ] || suites="$suites $t" ;; esac
     done
-    # Two lanes, though a suite mostly waits (the service's took 162 s for
+    # Two lanes, though a suite mostly waits (the service's took 321 s for
     # about 63 s of processor time): in four, the PostgreSQL pass's
     # cluster test, its daemons' workers yielding to everything else,
     # once ended a job off the command line's figures.
