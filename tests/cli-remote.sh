@@ -37,7 +37,8 @@ check() { # check CONDITION-STATUS WHAT
 }
 
 # a server on a free port with a fresh store
-"$build/tightknotd" --port 0 --db "$tmp/jobs.db" --workers 2 >"$tmp/daemon.log" 2>&1 &
+"$build/tightknotd" --port 0 --db "$tmp/jobs.db" --workers 2 \
+    ${TK_WORKER_PRIORITY:+--worker-priority "$TK_WORKER_PRIORITY"} >"$tmp/daemon.log" 2>&1 &
 pid=$!
 port=""
 for _ in $(seq 50); do

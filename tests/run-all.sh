@@ -63,11 +63,11 @@ run_unit() {
 # Runs $2 (run_unit or run_suite) on each of the list $1 in two lanes, one
 # a core: each lane takes the next not yet taken (mkdir is the lock), so
 # a list ordered longest first has its lanes end together.  Each one's
-# output goes to a file of its own; they are printed in the list's order
-# at the end and their counts added to the totals.  $3 names the lanes'
-# directory when one function runs twice.
-in_lanes() {
-    lanedir=$lanes/${3:-$2}
+# output goes to a file of its own in the lanes' directory $3;
+# lanes_report prints them in the list's order and adds their counts to
+# the totals.
+lanes_run() {
+    lanedir=$lanes/$3
     mkdir "$lanedir"
     for _ in 1 2; do
         (
@@ -80,10 +80,13 @@ in_lanes() {
         ) &
     done
     wait
+}
+
+lanes_report() {
     i=0
     for t in $1; do
         i=$((i + 1))
-        out="$lanedir/out.$i"
+        out="$lanes/$2/out.$i"
         counts=$(grep '^counts: ' "$out" 2>/dev/null | tail -n 1)
         if [ -z "$counts" ]; then
             failed=$((failed + 1)); echo "FAIL $t: no totals"; continue
@@ -114,7 +117,21 @@ units=$(printf '%s\n' $units)
 units="$(for name in starts tighten struts nnls history; do echo "$units" | grep -E "/test_$name\$"; done)
 $(echo "$units" | grep -vE "$long")"
 
-in_lanes "$units" run_unit
+# The unit tests (and the fuzz corpora's replays after them) run at the
+# lowest niceness, beside the suites below: a suite mostly waits on its
+# daemon's jobs (the service's took 321 s for about 63 s of processor
+# time), so the units take what the suites leave, and the suites, their
+# daemons' workers at normal priority (TK_WORKER_PRIORITY), run about as
+# on an idle machine.  Check's timeouts are of the wall clock: three
+# times theirs, for a unit test that waits on a busy suite.
+CK_TIMEOUT_MULTIPLIER=3
+export CK_TIMEOUT_MULTIPLIER
+(
+    renice -n 19 -p "$(exec sh -c 'echo $PPID')" >/dev/null
+    lanes_run "$units" run_unit units
+    [ "$unit_only" -eq 0 ] && [ -f tests/fuzz/run.sh ] && lanes_run "tests/fuzz/run.sh" run_suite fuzz
+) &
+idle=$!
 
 # The command-line tests (tests/cli-*.sh) and the suites in directories
 # (tests/*/run.sh: the service's API, the page in a browser, the fuzz
@@ -188,18 +205,19 @@ if [ "$unit_only" -eq 0 ]; then
     # PostgreSQL: the files whose jobs are stored, restarted and shared
     # (the others poke the SQLite file or never store a job)
     [ -n "$TK_PG_URL" ] && suites="$suites pg:tests/service/run.sh"
-    # the fuzz targets' short runs last and alone: the service's workers
-    # yield the CPU to anything else (--worker-priority idle), so a fuzzer
-    # beside its suite would starve the jobs it waits for
+    # the fuzz targets' replays run with the units, above
     for t in tests/cli-*.sh tests/*/run.sh; do
         case " $suites " in *" $t "*) ;; *) [ "$t" = tests/fuzz/run.sh ] || suites="$suites $t" ;; esac
     done
-    # Two lanes, though a suite mostly waits (the service's took 321 s for
-    # about 63 s of processor time): in four, the PostgreSQL pass's
-    # cluster test, its daemons' workers yielding to everything else,
-    # once ended a job off the command line's figures.
-    in_lanes "$suites" run_suite
-    [ -f tests/fuzz/run.sh ] && in_lanes "tests/fuzz/run.sh" run_suite fuzz
+    TK_WORKER_PRIORITY=normal
+    export TK_WORKER_PRIORITY
+    lanes_run "$suites" run_suite suites
+fi
+wait "$idle"
+lanes_report "$units" units
+if [ "$unit_only" -eq 0 ]; then
+    lanes_report "$suites" suites
+    [ -f tests/fuzz/run.sh ] && lanes_report "tests/fuzz/run.sh" fuzz
 fi
 
 echo "tests: $passed passed, $failed failed, $skipped skipped"

@@ -10,6 +10,8 @@
 //                 the tests that need one
 //   TK_STORE      "postgresql": every fresh daemon's store is a database of
 //                 its own on that server (default: a SQLite file)
+//   TK_WORKER_PRIORITY  every daemon's --worker-priority, unless a test
+//                 gives its own (default: the daemon's, idle)
 // Relative paths in the environment are taken from the current directory,
 // the defaults from the repository root.
 
@@ -242,6 +244,12 @@ export async function startDaemon(o = {}) {
     if (o.workers) args.push('--workers', String(o.workers));
     if (o.queueLimit) args.push('--queue-limit', String(o.queueLimit));
     if (o.maxBody) args.push('--max-body', String(o.maxBody));
+    // run-all.sh runs the unit tests beside the suites at the lowest
+    // niceness, and the daemon's idle workers would wait on them:
+    // TK_WORKER_PRIORITY (normal there) unless the test sets its own or
+    // wants the default (priority: null)
+    const priority = o.priority === undefined ? process.env.TK_WORKER_PRIORITY : o.priority;
+    if (priority && !(o.args ?? []).includes('--worker-priority')) args.push('--worker-priority', priority);
     args.push(...(o.args ?? []));
     const proc = spawn(DAEMON, args, { stdio: ['ignore', 'pipe', 'pipe'] });
     live.add(proc);

@@ -26,7 +26,7 @@ const workers = (pid) => threads(pid).filter((t) => t.name === 'tk-worker');
 
 describe('worker threads', { skip: process.platform !== 'linux' && 'needs /proc' }, () => {
     test('by default 3 workers run under SCHED_IDLE, and no other thread does', async () => {
-        const d = await startDaemon({ workers: 3 });
+        const d = await startDaemon({ workers: 3, priority: null });
         try {
             const all = threads(d.proc.pid);
             const pool = all.filter((t) => t.name === 'tk-worker');

@@ -6,6 +6,7 @@
 //   TK_DAEMON     the daemon (default build/tightknotd)
 //   TK_CATALOGUE  the catalogue directory (default ../shared/catalogue)
 //   TK_WEB        the built page (default build/web, see tools/build-web.sh)
+//   TK_WORKER_PRIORITY  the daemon's --worker-priority (default its own)
 
 import { spawn } from 'node:child_process';
 import { mkdtempSync, rmSync } from 'node:fs';
@@ -29,6 +30,10 @@ export async function startDaemon(extra = []) {
     const tmp = mkdtempSync(join(tmpdir(), 'tk-web-'));
     const args = ['--port', '0', '--db', join(tmp, 'jobs.db'), '--catalogue', CATALOGUE, '--web', WEB, '--workers', '2',
         ...extra];
+    // beside the unit tests at the lowest niceness (run-all.sh), workers
+    // of the default, idle, priority would wait on them
+    if (process.env.TK_WORKER_PRIORITY && !extra.includes('--worker-priority'))
+        args.push('--worker-priority', process.env.TK_WORKER_PRIORITY);
     const daemon = spawn(DAEMON, args, { stdio: ['ignore', 'pipe', 'pipe'] });
     const stop = async () => {
         if (daemon.exitCode === null && daemon.signalCode === null) {
