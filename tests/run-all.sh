@@ -10,6 +10,7 @@ unit_only=0
 if [ "${1:-}" = "--unit-only" ]; then unit_only=1; shift; fi
 build=$1
 asan=${2:-}
+tsan=build/tsan
 TK_CATALOGUE=$3
 export TK_CATALOGUE
 if [ ! -d "$TK_CATALOGUE" ]; then
@@ -117,22 +118,6 @@ units=$(printf '%s\n' $units)
 units="$(for name in starts tighten struts nnls history; do echo "$units" | grep -E "/test_$name\$"; done)
 $(echo "$units" | grep -vE "$long")"
 
-# The unit tests (and the fuzz corpora's replays after them) run at the
-# lowest niceness, beside the suites below: a suite mostly waits on its
-# daemon's jobs (the service's took 321 s for about 63 s of processor
-# time), so the units take what the suites leave, and the suites, their
-# daemons' workers at normal priority (TK_WORKER_PRIORITY), run about as
-# on an idle machine.  Check's timeouts are of the wall clock: three
-# times theirs, for a unit test that waits on a busy suite.
-CK_TIMEOUT_MULTIPLIER=3
-export CK_TIMEOUT_MULTIPLIER
-(
-    renice -n 19 -p "$(exec sh -c 'echo $PPID')" >/dev/null
-    lanes_run "$units" run_unit units
-    [ "$unit_only" -eq 0 ] && [ -f tests/fuzz/run.sh ] && lanes_run "tests/fuzz/run.sh" run_suite fuzz
-) &
-idle=$!
-
 # The command-line tests (tests/cli-*.sh) and the suites in directories
 # (tests/*/run.sh: the service's API, the page in a browser, the fuzz
 # corpora replayed in both builds) all end with
@@ -191,8 +176,36 @@ run_suite() {
     echo "counts: $p $f ${k:-0}"
 }
 
+# A unit test program, or a suite given as suite:PATH (the fuzz corpora's
+# replays, as CPU-bound as a unit test), with its output to $2.
+run_idle() {
+    case "$1" in
+    suite:*) run_suite "${1#suite:}" "$2" ;;
+    *) run_unit "$1" "$2" ;;
+    esac
+}
+
+# The unit tests and the fuzz corpora's replays (after the long units) run
+# at the lowest niceness, beside the suites below: a suite mostly waits on
+# its daemon's jobs (the service's took 321 s for about 63 s of processor
+# time), so the units take what the suites leave, and the suites, their
+# daemons' workers at normal priority (TK_WORKER_PRIORITY), run about as
+# on an idle machine.  Check's timeouts are of the wall clock: three
+# times theirs, for a unit test that waits on a busy suite.
+if [ "$unit_only" -eq 0 ] && [ -f tests/fuzz/run.sh ]; then
+    units="$(echo "$units" | grep -E "$long")
+suite:tests/fuzz/run.sh
+$(echo "$units" | grep -vE "$long")"
+fi
+CK_TIMEOUT_MULTIPLIER=3
+export CK_TIMEOUT_MULTIPLIER
+(
+    renice -n 19 -p "$(exec sh -c 'echo $PPID')" >/dev/null
+    lanes_run "$units" run_idle units
+) &
+idle=$!
+
 if [ "$unit_only" -eq 0 ]; then
-    tsan=build/tsan
     # the longest first: the service's suite, in each build and store
     suites="tests/service/run.sh"
     [ -n "$asan" ] && [ -x "$asan/tightknotd" ] && suites="$suites asan:tests/service/run.sh"
@@ -215,10 +228,7 @@ if [ "$unit_only" -eq 0 ]; then
 fi
 wait "$idle"
 lanes_report "$units" units
-if [ "$unit_only" -eq 0 ]; then
-    lanes_report "$suites" suites
-    [ -f tests/fuzz/run.sh ] && lanes_report "tests/fuzz/run.sh" fuzz
-fi
+[ "$unit_only" -eq 0 ] && lanes_report "$suites" suites
 
 echo "tests: $passed passed, $failed failed, $skipped skipped"
 [ "$failed" -eq 0 ]
