@@ -161,7 +161,8 @@ int tk_active_find(tk_run *r, const tk_curve *c, tk_constraints *set, tk_error *
 /* The contacts that become active mid-step (section 4.5): found again with
  * the tree at the trial point, and added with their values at the current
  * curve so the next resolution keeps them to first order. */
-int tk_active_expand(tk_run *r, const tk_curve *trial, size_t *added, tk_error *err)
+int tk_active_expand(tk_run *r, const tk_curve *trial, size_t most, size_t *added,
+                     tk_error *err)
 {
     const tk_curve *c = r->shared.curve;
     tk_constraints *set = &r->active.set;
@@ -171,6 +172,14 @@ int tk_active_expand(tk_run *r, const tk_curve *trial, size_t *added, tk_error *
     tk_strut_list broken = {0};
     int rc = tk_strut_finder_find(r->shared.finder, trial, TK_ARC_ADMISSIBLE, r->tau,
                                   r->tau * floor, &broken, err);
+    size_t fresh = 0;
+    for (size_t j = 0; !rc && j < broken.count && fresh <= most; j++)
+        fresh += !has_strut(&set->struts, &broken.items[j]);
+    if (fresh > most) {
+        tk_strut_list_free(&broken);
+        r->active.search_seconds += tk_clock() - t0;
+        return rc;
+    }
     for (size_t j = 0; !rc && j < broken.count; j++) {
         tk_strut s = broken.items[j];
         if (has_strut(&set->struts, &s))

@@ -365,8 +365,10 @@ void tk_type_free(tk_run *r);
  * to c). */
 int tk_active_find(tk_run *r, const tk_curve *c, tk_constraints *set, tk_error *err);
 /* Adds to the active set the constraints a step to `trial` broke that were
- * not active (the finder fitted to `trial`); *added counts them. */
-int tk_active_expand(tk_run *r, const tk_curve *trial, size_t *added, tk_error *err);
+ * not active (the finder fitted to `trial`); *added counts them.  When the
+ * struts among them are more than `most`, none is added (*added 0). */
+int tk_active_expand(tk_run *r, const tk_curve *trial, size_t most, size_t *added,
+                     tk_error *err);
 /* The rigidity matrix of a set at c, the rows of pinned vertices projected
  * onto the directions their constraints allow (tk_pin_project). */
 int tk_active_matrix(tk_run *r, const tk_curve *c, const tk_constraints *set,

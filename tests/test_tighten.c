@@ -839,6 +839,46 @@ START_TEST(a_fine_tight_polygon_is_restored_in_place)
 }
 END_TEST
 
+/* A step's first trials can be far longer than the step it takes: a tight
+ * polygon taken up again at a deep polishing level tries twice its last
+ * step, or an eighth of the largest the motion allows, and such a trial
+ * crosses pairs all along the curve.  The pairs a trial crosses join the
+ * active set only when they are no more than the set holds (or a quarter
+ * of the vertices); a longer trial is halved first (stepping.c,
+ * expand_most).  Before that rule the tight 2,400-vertex trefoil's first
+ * step at level 3 carried 5,543 struts and the one after it 955; at
+ * 9,600 vertices a first step carried 36,079 and took 72 s
+ * (bench/FIGURES.md). */
+START_TEST(an_expansion_leaves_a_long_trial_s_crossings_out)
+{
+    tk_curve *c = test_data("trefoil-2400.vect");
+    tk_options o = TK_OPTIONS_INIT;
+    o.coarse_to_fine = false;
+    o.escapes = 0;
+    tk_run *run = resumed_at_level(c, &o, 3);
+    tk_error err;
+    size_t before = tk_run_latest(run)->struts, quarter = c->nvert / 4;
+    double rope = tk_run_latest(run)->ropelength;
+    ck_assert_msg(tk_run_step(run, &err) == TK_OK, "%s", err.message);
+    const tk_step_report *s = tk_run_latest(run);
+    tk_measure m;
+    ck_assert_int_eq(tk_thickness_measure(tk_run_curve(run), NULL, &m, NULL), TK_OK);
+    printf("tight trefoil at level 3: %zu struts at step 0, %zu carried by step 1 (step %.3g), "
+           "ropelength %.9f to %.9f, thickness 1 %+.3g\n", before, s->struts, s->step_size, rope,
+           s->ropelength, m.thickness - 1.0);
+    /* an expansion at most doubles the set (or adds a quarter of the
+     * vertices); after one, a second adds what the shorter trial still
+     * crosses, here few: 952 struts became 1,608 */
+    size_t most = before > quarter ? before : quarter;
+    ck_assert_msg(s->struts <= before + most, "%zu struts after %zu", s->struts, before);
+    ck_assert(s->step_size > 0.0);
+    ck_assert(s->ropelength < rope);
+    ck_assert(m.thickness >= 1.0 - o.overstep_tolerance);
+    tk_run_free(&run);
+    tk_curve_free(&c);
+}
+END_TEST
+
 START_TEST(a_fine_tight_curve_polishes_at_the_rate_of_its_fall)
 {
     /* The tight 600-vertex trefoil resumed at polishing level 2, where its
@@ -3242,6 +3282,7 @@ int main(void)
     tcase_add_test(tc, recovery_restores_thousands_of_contacts_without_rescaling);
     tcase_add_test(tc, a_fine_start_is_set_up_with_the_tolerance_of_its_edges);
     tcase_add_test(tc, a_fine_tight_polygon_is_restored_in_place);
+    tcase_add_test(tc, an_expansion_leaves_a_long_trial_s_crossings_out);
     tcase_add_test(tc, a_tight_start_refined_and_autoscaled_keeps_its_contacts);
     tcase_add_test(tc, a_tight_start_refined_sixteen_times_over_keeps_its_place);
     tcase_add_test(tc, a_tight_curve_tightened_again_steps_at_a_bounded_cost);
