@@ -61,7 +61,7 @@ run_unit() {
     echo "counts: $((checks - bad - skips)) $bad $skips"
 }
 
-# Runs $2 (run_unit or run_suite) on each of the list $1 in two lanes, one
+# Runs $2 (run_idle or run_suite) on each of the list $1 in two lanes, one
 # a core: each lane takes the next not yet taken (mkdir is the lock), so
 # a list ordered longest first has its lanes end together.  Each one's
 # output goes to a file of its own in the lanes' directory $3;
