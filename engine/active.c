@@ -172,18 +172,19 @@ int tk_active_expand(tk_run *r, const tk_curve *trial, size_t most, size_t *adde
     tk_strut_list broken = {0};
     int rc = tk_strut_finder_find(r->shared.finder, trial, TK_ARC_ADMISSIBLE, r->tau,
                                   r->tau * floor, &broken, err);
+    /* the pairs not in the set, kept at the front (the finder's pairs are
+     * distinct, so none of them is checked against another) */
     size_t fresh = 0;
-    for (size_t j = 0; !rc && j < broken.count && fresh <= most; j++)
-        fresh += !has_strut(&set->struts, &broken.items[j]);
+    for (size_t j = 0; !rc && j < broken.count; j++)
+        if (!has_strut(&set->struts, &broken.items[j]))
+            broken.items[fresh++] = broken.items[j];
     if (fresh > most) {
         tk_strut_list_free(&broken);
         r->active.search_seconds += tk_clock() - t0;
         return rc;
     }
-    for (size_t j = 0; !rc && j < broken.count; j++) {
+    for (size_t j = 0; !rc && j < fresh; j++) {
         tk_strut s = broken.items[j];
-        if (has_strut(&set->struts, &s))
-            continue;
         tk_closest cl;
         tk_segment_closest(tk_curve_vertex(c, tk_curve_vertex_index(c, s.comp[0], s.edge[0])),
                            tk_curve_vertex(c, tk_curve_vertex_index(c, s.comp[0], s.edge[0] + 1)),
