@@ -3,6 +3,7 @@
  * gradient alone when the equalising motion blocks it, and the retries
  * with a shorter step when error recovery cannot restore the thickness.
  * See run.h for the rooms of the flow. */
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -181,9 +182,17 @@ static int judge_corrected(tk_run *r, tk_step_report *rep, double h, double meri
  * follows.  On the trefoil at 9,600 vertices a trial at about 100 times the
  * usual step crossed 17,321 pairs besides the 5,543 in the set, and the
  * step's resolution carried them all: 18.8 s for a step where the steps
- * around it took 0.1 to 0.3 s (bench/FIGURES.md). */
+ * around it took 0.1 to 0.3 s (bench/FIGURES.md).  Only from
+ * EXPAND_BOUNDED_VERTICES on: on coarser polygons such a step costs
+ * little, and the bound changed where the escapes' tries went: T(3,4) at
+ * resolution 5 (306 vertices, 60 s) ended in the basin 0.05% above
+ * 8_19's with 5 of 6 seeds, against 1 of 6 without it. */
+#define EXPAND_BOUNDED_VERTICES 1334
+
 static size_t expand_most(const tk_run *r)
 {
+    if (r->shared.curve->nvert < EXPAND_BOUNDED_VERTICES)
+        return SIZE_MAX;
     const tk_constraints *set = &r->active.set;
     size_t held = set->struts.count + set->nkinks, quarter = r->shared.curve->nvert / 4;
     return held > quarter ? held : quarter;
