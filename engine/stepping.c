@@ -183,8 +183,9 @@ static int judge_corrected(tk_run *r, tk_step_report *rep, double h, double meri
  * usual step crossed 17,321 pairs besides the 5,543 in the set, and the
  * step's resolution carried them all: 18.8 s for a step where the steps
  * around it took 0.1 to 0.3 s (bench/FIGURES.md).  Only from
- * EXPAND_BOUNDED_VERTICES on: on coarser polygons such a step costs
- * little, and the bound changed where the escapes' tries went: T(3,4) at
+ * EXPAND_BOUNDED_VERTICES on (the 4,000 coordinates below which the
+ * NNLS's coordinate form changes nothing either, engine/nnls.c): there
+ * the bound changed where the escapes' tries went, and T(3,4) at
  * resolution 5 (306 vertices, 60 s) ended in the basin 0.05% above
  * 8_19's with 5 of 6 seeds, against 1 of 6 without it. */
 #define EXPAND_BOUNDED_VERTICES 1334
