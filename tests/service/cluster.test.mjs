@@ -97,8 +97,12 @@ describe('three daemons on one PostgreSQL database', { skip }, () => {
 
         // the command line's figures: bit for bit for a job that ran through;
         // a resumed run goes on from its stored curve (not the solver's
-        // warm state), so it ends at the same step and polygon, its
-        // ropelength within 0.2%
+        // warm state), so it ends at the same step and polygon, of the
+        // start's type.  Its flow is another path from there: at step 2000
+        // the curve is still falling (about 0.1% a hundred steps for 4.1),
+        // and a resumed 4.1 has ended 0.54% below the command line's.  So
+        // its ropelength is held on one side (the resume lost no more
+        // than 0.2% of the tightening) and its thickness holds the diameter
         for (let i = 0; i < 12; i++) {
             const job = done[i], want = cli[i % 4].summary;
             assert.equal(job.state, 'done', JSON.stringify(job));
@@ -106,10 +110,14 @@ describe('three daemons on one PostgreSQL database', { skip }, () => {
             assert.equal(job.progress.step, STEPS);
             assert.equal(job.vertices, want.vertices);
             const resumed = all.filter((r) => r.id === job.id).length > 1;
-            if (resumed)
-                assert.ok(Math.abs(job.ropelength - want.ropelength) < 2e-3 * want.ropelength,
+            assert.deepEqual(job.invariants.result, job.invariants.start, `job ${job.id}'s type`);
+            if (resumed) {
+                t.diagnostic(`resumed job ${job.id} (${starts[i % 4]}): ${job.ropelength} against ` +
+                    `the command line's ${want.ropelength}`);
+                assert.ok(job.ropelength < (1 + 2e-3) * want.ropelength,
                     `resumed job ${job.id}: ${job.ropelength} against ${want.ropelength}`);
-            else
+                assert.ok(job.thickness >= 1 - 1e-5, `resumed job ${job.id}: thickness ${job.thickness}`);
+            } else
                 assert.equal(job.ropelength, want.ropelength, `job ${job.id} (${starts[i % 4]})`);
         }
         await stopAll(daemons[0], daemons[2]);
