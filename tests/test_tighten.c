@@ -1717,13 +1717,18 @@ START_TEST(cpu_time_counts_the_run_s_own_processor_time)
         } else {
             /* the wall clock counts them: the run stopped at its first step
              * past its budget of wall time (however long a busy machine made
-             * that step) */
+             * that step), or at its start where a busy machine's setting up
+             * took the budget (seen beside the service's suites) */
             size_t nh = 0;
             const tk_step_report *h = tk_run_history(run, &nh);
             ck_assert(s->seconds <= wall);
-            ck_assert_uint_ge(nh, 2);
-            ck_assert_int_eq(h[nh - 2].step, s->step - 1);
-            ck_assert(h[nh - 2].seconds < budget);
+            ck_assert_uint_ge(nh, 1);
+            if (nh == 1) {
+                ck_assert_int_eq(s->step, 0);
+            } else {
+                ck_assert_int_eq(h[nh - 2].step, s->step - 1);
+                ck_assert(h[nh - 2].seconds < budget);
+            }
         }
         tk_run_free(&run);
     }
@@ -3274,8 +3279,6 @@ int main(void)
     tcase_add_test(tc, the_last_fifth_of_the_budget_polishes_the_best);
     tcase_add_test(tc, a_best_put_back_is_polished_not_replayed);
     tcase_add_test(tc, a_run_that_tried_no_escape_returns_its_best);
-    tcase_add_test(tc, a_try_behind_on_its_coarsest_polygon_is_given_up_there);
-    tcase_add_test(tc, an_explored_try_leaves_a_coarse_trap);
     tcase_add_test(tc, the_first_explored_try_turns_the_start);
     tcase_add_test(tc, converge_stops_where_the_flow_has_no_more_to_give);
     tcase_add_test(tc, the_defaults_tighten_the_figure_eight);
@@ -3299,7 +3302,6 @@ int main(void)
     tcase_add_test(tc, a_refined_tight_polygon_is_restored_without_rescaling);
     tcase_add_test(tc, a_loose_curve_is_kept_at_the_tube);
     tcase_add_test(tc, a_loose_start_keeps_its_final_count_through_escapes);
-    tcase_add_test(tc, loose_levels_come_first_for_every_loose_try);
     tcase_add_test(tc, a_loose_coarse_level_follows_the_ropelength);
     tcase_add_test(tc, a_loose_level_keeps_its_polygon_where_fewer_vertices_lose_the_type);
     tcase_add_test(tc, a_loose_try_starts_on_its_own_count);
@@ -3315,6 +3317,16 @@ int main(void)
     tcase_add_test(tc, trefoil_does_not_stall_near_its_critical_point);
     tcase_add_test(tc, generated_chain_of_three_tightens_to_12_pi_plus_4);
     suite_add_tcase(s, tc);
+    /* The three longest (about 300 s of the program's 540 on one idle
+     * core), tagged so that tests/run-all.sh runs them in a process of
+     * their own beside the rest (CK_INCLUDE_TAGS / CK_EXCLUDE_TAGS). */
+    TCase *long_runs = tcase_create("long");
+    tcase_set_tags(long_runs, "long");
+    tcase_set_timeout(long_runs, 900);
+    tcase_add_test(long_runs, an_explored_try_leaves_a_coarse_trap);
+    tcase_add_test(long_runs, loose_levels_come_first_for_every_loose_try);
+    tcase_add_test(long_runs, a_try_behind_on_its_coarsest_polygon_is_given_up_there);
+    suite_add_tcase(s, long_runs);
     /* A hang here is the failure: a short timeout. */
     TCase *range = tcase_create("range");
     tcase_set_timeout(range, 30);
