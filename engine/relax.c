@@ -81,11 +81,12 @@ static double energy(const tk_curve *c, const tk_curve *target, double pull, dou
             if (gap)
                 *gap = fmin(*gap, cl.dist);
             double r2 = cl.dist * cl.dist;
-            repulsion += h2 / r2;
+            double q = h2 / r2, term = q * q;
+            repulsion += term;
             if (!grad)
                 continue;
-            /* d(h^2 / r^2) = -2 h^2 / r^3 dr, dr by equation 7 */
-            double g[12], f = -2.0 * h2 / (r2 * cl.dist);
+            /* d(h^4 / r^4) = -4 h^4 / r^5 dr, dr by equation 7 */
+            double g[12], f = -4.0 * term / cl.dist;
             tk_segment_distance_gradient(&cl, g);
             size_t at[4] = {a.head, a.tail, b.head, b.tail};
             for (int p = 0; p < 4; p++)
@@ -103,11 +104,11 @@ static double energy(const tk_curve *c, const tk_curve *target, double pull, dou
             grad[3 * v + k] += 2.0 * pull * d[k] / (ht * ht);
     }
     /* The springs; then the terms of the gradient through h (h_c drops
-     * out: a component's deviations from it sum to 0): h^2 in the
-     * repulsion gives 2 E_rep dL / L, 1 / h^2 in the springs -2 E_spr
+     * out: a component's deviations from it sum to 0): h^4 in the
+     * repulsion gives 4 E_rep dL / L, 1 / h^2 in the springs -2 E_spr
      * dL / L, dL the length's gradient (equation 14). */
     for (int pass = 0; pass < 2; pass++) {
-        double scale = 2.0 * (repulsion - springs) / length;
+        double scale = (4.0 * repulsion - 2.0 * springs) / length;
         for (size_t comp = 0; comp < c->ncomp; comp++) {
             size_t edges = tk_curve_comp_edges(c, comp);
             double hc = tk_curve_comp_length(c, comp) / (double)edges;

@@ -13,15 +13,22 @@
  * use it to even out what they make.
  *
  * The energy (of the vertices x_i, h the mean edge length):
- *     E = sum over pairs of edges of h^2 / r^2
+ *     E = sum over pairs of edges of h^4 / r^4
  *       + w sum over edges e of a component of mean edge length h_c,
  *             of (|e| - h_c)^2 / h^2,
  * over pairs of edges that share no vertex, r their distance (not the
  * vertices': an edge can pass between two vertices, not through an edge
- * whose distance enters E), the first a discrete form of the
- * Moebius-like energy 1 / |x - y|^2 (near pairs penalise bending, far
- * ones closeness), the second springs that keep the vertices evenly
- * spread (w = 20).  With a target curve y of as many vertices, a pull
+ * whose distance enters E), the first a discrete form of the energy
+ * 1 / |x - y|^4 (near pairs penalise bending, far ones closeness), the
+ * second springs that keep the vertices evenly spread (w = 20).  The
+ * power is 4, not the Moebius energy's 2: 1 / |x - y|^2 is scale
+ * invariant, a narrow passage costs it no more than a wide one of the
+ * same shape, and relaxed polygons kept passages as narrow as half an
+ * edge, so that a polygon on more vertices came out narrower (a turn of
+ * catalogue 10.14 on 468 vertices: strands 0.52 of an edge apart,
+ * ropelength 1,786; with the fourth power 0.97 of an edge, 900; the
+ * turns of 14 knots of 8 to 10 crossings 0.52 to 0.96 of an edge apart,
+ * now 0.97 to 0.99, and 27% to 60% shorter: bench/FIGURES.md).  With a target curve y of as many vertices, a pull
  *       + p sum over vertices of |x_i - y_i|^2 / h_y^2 (h_y the target's mean edge)
  * draws the curve toward y while the repulsion keeps its strands apart:
  * a deformation as large as the knot itself that is an isotopy, where a
