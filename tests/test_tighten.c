@@ -2347,7 +2347,10 @@ static void loose_run_end(tk_run **run, tk_invariants *type)
  * the replaced curve's ropelength, the level stayed at 196 for 6,500
  * steps).  The first explored try is now the start turned (escape.c,
  * turned_start): 234.81 on 170 vertices, replacing 74.93, down to 127 by
- * step 4,636.
+ * step 4,636; with the relaxation's fourth power (tk/relax.h), whose
+ * turns are less narrow, 140.72 on 85, replacing 75.00, down to 63 by
+ * step 5,502: still nearly twice as loose as the curve it replaced,
+ * whose count (47) the old check would have given it.
  * Every step is taken, each polygon of the start's type (the run checks
  * every resampling), and the curve at the end is of the start's type by
  * the invariants computed here. */
@@ -2383,9 +2386,10 @@ START_TEST(a_loose_level_keeps_its_polygon_where_fewer_vertices_lose_the_type)
     printf("9.45 wandered: its first try from %.2f (replacing %.2f) on %zu vertices, down to %zu "
            "by step %ld at %.4f\n", from, replaced, first, least, tk_run_latest(run)->step,
            tk_run_latest(run)->ropelength);
+    fflush(stdout);
     ck_assert_uint_gt(first, 0);
     /* a try far looser than the curve it replaced, which came down */
-    ck_assert_double_gt(from, 3.0 * replaced);
+    ck_assert_double_gt(from, 1.5 * replaced);
     ck_assert_uint_lt(least, first);
     loose_run_end(&run, &type);
     tk_curve_free(&c);
