@@ -28,7 +28,8 @@
  * catalogue 10.14 on 468 vertices: strands 0.52 of an edge apart,
  * ropelength 1,786; with the fourth power 0.97 of an edge, 900; the
  * turns of 14 knots of 8 to 10 crossings 0.52 to 0.96 of an edge apart,
- * now 0.97 to 0.99, and 27% to 60% shorter: bench/FIGURES.md).  With a target curve y of as many vertices, a pull
+ * now 0.97 to 0.99, and 27% to 60% shorter: bench/FIGURES.md).
+ * With a target curve y of as many vertices, a pull
  *       + p sum over vertices of |x_i - y_i|^2 / h_y^2 (h_y the target's mean edge)
  * draws the curve toward y while the repulsion keeps its strands apart:
  * a deformation as large as the knot itself that is an isotopy, where a
