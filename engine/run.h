@@ -133,6 +133,8 @@ struct tk_run {
         double *work;    /* 3V */
         double *x;       /* compressions, one per constraint */
         size_t x_capacity;
+        double *x_last;  /* the last round's answer (momentum, motion.c) */
+        size_t x_last_capacity;
         bool kept;       /* the last solve's factor is kept (tk/nnls.h) */
         double weight;   /* the proximal weight the last such solve ended
                             at (0: none) */
