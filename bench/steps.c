@@ -56,7 +56,7 @@ static void row(const tk_run *run, const tk_run_timing *a, const tk_run_timing *
     const tk_strut *struts = tk_run_struts(run, &ns);
     for (size_t j = 0; j < ns; j++)
         forced += struts[j].force > 0.0;
-    printf("%8zu %7zu %6zu %6zu %9.1f %10.6f | %8.1f %8.1f %8.1f %8.1f %8.1f %8.1f %8.1f | "
+    printf("%8zu %7zu %6zu %6zu %9.1f %13.9f | %8.1f %8.1f %8.1f %8.1f %8.1f %8.1f %8.1f | "
            "%6.1f %6.1f\n",
            last->vertices, last->struts, forced, last->kinks, ms * (b->total - a->total),
            last->ropelength, ms * (b->search - a->search), ms * (b->matrix - a->matrix),
@@ -70,7 +70,7 @@ static void row(const tk_run *run, const tk_run_timing *a, const tk_run_timing *
 
 static void header(void)
 {
-    printf("\n%8s %7s %6s %6s %9s %10s | %8s %8s %8s %8s %8s %8s %8s | %6s %6s\n",
+    printf("\n%8s %7s %6s %6s %9s %13s | %8s %8s %8s %8s %8s %8s %8s | %6s %6s\n",
            "vertices", "struts", "forced", "kinks", "ms/step", "ropelength", "search", "matrix",
            "nnls", "checks", "stepping", "recovery", "figures", "iter", "facts");
 }
