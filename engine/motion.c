@@ -109,7 +109,7 @@ int tk_motion_fit(tk_run *r, size_t vertices, tk_error *err)
  * or not at all, and it converges linearly, by mu / (lambda + mu) a round
  * along an eigenvalue lambda of the scaled normal matrix: on the tight
  * trefoil at 9,600 vertices (14,000 struts, nearly dependent) a step's
- * term fell by a fifth a round, and a step took 20 to 40 rounds.  So the
+ * term fell by a fifth a round, and a step took 7 to 40 rounds.  So the
  * next round is centred at the answer extrapolated along the last round's
  * change, x_k + beta_k (x_k - x_{k-1}), clipped at 0: the accelerated
  * proximal point method (Guler 1992, with the step rule of Beck and

@@ -15,10 +15,10 @@
 #include "support.h"
 #include "tk/curve.h"
 #include "tk/generate.h"
+#include "tk/geometry.h"
 #include "tk/invariants.h"
 #include "tk/relax.h"
 #include "tk/rigidity.h"
-#include "tk/geometry.h"
 #include "tk/thickness.h"
 #include "tk/record.h"
 #include "tk/tighten.h"
@@ -882,53 +882,30 @@ START_TEST(an_expansion_leaves_a_long_trial_s_crossings_out)
 END_TEST
 
 /* The plain problem's optimality conditions for a step's forces f, from
- * what the run reports: its struts and kinks, rebuilt as the rigidity
- * matrix A at the curve the step started from (c), and v = -grad L + A f.
- * Into worst: the most negative a_i . v / (|a_i| |v|) over the
- * constraints (a motion that shortens no contact at first order has none
- * below 0), and into term: |(A f) . v| / |v|^2 (0 at the answer).
- * A kink's gradient is the branch of its shorter edge, or both branches
- * for a vertex listed twice, in order (engine/active.c). */
+ * what the run reports: its struts (it must have no kinks), rebuilt as
+ * the rigidity matrix A at the curve the step started from (c), and
+ * v = -grad L + A f.  Into worst: the most negative a_i . v / (|a_i| |v|)
+ * over the struts (a motion that shortens no contact at first order has
+ * none below 0), and into term: |(A f) . v| / |v|^2 (0 at the answer). */
 static void forces_resolve(const tk_curve *c, const tk_run *run, double *worst, double *term)
 {
     size_t ns = 0, nk = 0, n3 = 3 * c->nvert;
     const tk_strut *struts = tk_run_struts(run, &ns);
-    const tk_kink *kinks = tk_run_kinks(run, &nk);
-    unsigned char *edge = malloc(nk ? nk : 1);
-    ck_assert_ptr_nonnull(edge);
-    for (size_t k = 0; k < nk; k++) {
-        if (k > 0 && kinks[k - 1].comp == kinks[k].comp && kinks[k - 1].vertex == kinks[k].vertex) {
-            edge[k - 1] = 0;
-            edge[k] = 1;
-            continue;
-        }
-        size_t v = tk_curve_vertex_index(c, kinks[k].comp, kinks[k].vertex), prev, next;
-        ck_assert_int_eq(tk_curve_vertex_neighbours(c, v, &prev, &next), 1);
-        double g[9];
-        double r0 = tk_vertex_radius_gradient(tk_curve_vertex(c, prev), tk_curve_vertex(c, v),
-                                              tk_curve_vertex(c, next), 0, g);
-        double r1 = tk_vertex_radius_gradient(tk_curve_vertex(c, prev), tk_curve_vertex(c, v),
-                                              tk_curve_vertex(c, next), 1, g);
-        edge[k] = r1 < r0;
-    }
+    (void)tk_run_kinks(run, &nk);
+    ck_assert_uint_eq(nk, 0);
     cholmod_common cc;
     cholmod_start(&cc);
     cholmod_sparse *a = NULL;
-    tk_kink *plain = malloc((nk ? nk : 1) * sizeof *plain);
-    ck_assert_ptr_nonnull(plain);
-    memcpy(plain, kinks, nk * sizeof *plain);
-    ck_assert_int_eq(tk_rigidity_build_branches(c, struts, ns, plain, edge, nk, &cc, &a, NULL),
-                     TK_OK);
+    ck_assert_int_eq(tk_rigidity_build(c, struts, ns, NULL, 0, &cc, &a, NULL), TK_OK);
     double *v = malloc(n3 * sizeof *v), *af = calloc(n3, sizeof *af);
     ck_assert(v && af);
     tk_curve_length_gradient(c, v);
     const int *ap = a->p, *ai = a->i;
     const double *ax = a->x;
-    for (size_t j = 0; j < a->ncol; j++) {
-        double f = j < ns ? struts[j].force : kinks[j - ns].force;
-        ck_assert(f >= 0.0);
+    for (size_t j = 0; j < ns; j++) {
+        ck_assert(struts[j].force >= 0.0);
         for (int e = ap[j]; e < ap[j + 1]; e++)
-            af[ai[e]] += ax[e] * f;
+            af[ai[e]] += ax[e] * struts[j].force;
     }
     double vv = 0.0, afv = 0.0;
     for (size_t i = 0; i < n3; i++) {
@@ -937,7 +914,7 @@ static void forces_resolve(const tk_curve *c, const tk_run *run, double *worst, 
         afv += af[i] * v[i];
     }
     *worst = 0.0;
-    for (size_t j = 0; j < a->ncol; j++) {
+    for (size_t j = 0; j < ns; j++) {
         double dot = 0.0, norm = 0.0;
         for (int e = ap[j]; e < ap[j + 1]; e++) {
             dot += ax[e] * v[ai[e]];
@@ -949,8 +926,6 @@ static void forces_resolve(const tk_curve *c, const tk_run *run, double *worst, 
     *term = fabs(afv) / vv;
     free(v);
     free(af);
-    free(plain);
-    free(edge);
     cholmod_free_sparse(&a, &cc);
     cholmod_finish(&cc);
 }
@@ -972,8 +947,9 @@ START_TEST(a_fine_curve_s_forces_resolve_its_motion)
     o.escapes = 0;
     o.equalise = 0.0;
     /* no kinks: the run reports a vertex's two radius functions as one
-     * kink with their forces summed, which the matrix cannot be rebuilt
-     * from */
+     * kink with their forces summed, from which the matrix cannot be
+     * rebuilt; the curve's radii of curvature are five times this
+     * bound */
     o.lambda = 0.2;
     tk_run *run = resumed_at_level(c, &o, 3);
     tk_error err;
