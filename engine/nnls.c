@@ -648,6 +648,7 @@ typedef struct nnls_work {
     double rcond_floor;
     int max_iter;
     double mu;            /* the proximal weight (0: the plain problem) */
+    double unrefined;     /* opts->unrefined */
     double *centre;       /* n: the proximal centre c (when mu > 0) */
     double *colnorm;      /* s_i = ||a_i|| */
     double *inv_norm;     /* 1 / s_i, 0 for zero columns */
@@ -881,7 +882,12 @@ static int primal_alloc(nnls_work *w, tk_error *err)
  * space, whose residual h = P_F' b + mu z_c - (P_F' P_F + mu I) z comes
  * from P and whose correction (P_F' P_F + mu I)^-1 h is
  * (h - P_F' (P_F P_F' + mu I)^-1 P_F h) / mu: it loses about eps / mu of
- * itself, not of z, so one step suffices (figures above). */
+ * itself, not of z, so one step suffices (figures above).  The step is a
+ * second solve with the factor, and where the factor is kept solves are
+ * much of a flow step's time (bench/FIGURES.md, "Passive solves without
+ * refinement"): from mu >= w->unrefined (when set) it is left out, which
+ * the caller may ask where eps / mu is well below the KKT tolerance
+ * (2e-11 of relative residual at 1e-6, above, against 1e-10). */
 static int primal_answer(nnls_work *w, cholmod_factor *L, double *out, tk_error *err)
 {
     size_t m = w->m, n = w->n;
@@ -903,6 +909,13 @@ static int primal_answer(nnls_work *w, cholmod_factor *L, double *out, tk_error 
     if (rc != TK_OK)
         return rc;
     memcpy(y, sol, m * sizeof *y);
+    if (w->unrefined > 0.0 && w->mu >= w->unrefined) {
+        for (size_t i = 0; i < n; i++)
+            out[i] = w->passive[i]
+                         ? (w->colnorm[i] * w->centre[i] + col_dot(w->P, i, y)) * w->inv_norm[i]
+                         : 0.0;
+        return TK_OK;
+    }
     memset(v, 0, m * sizeof *v);
     for (size_t i = 0; i < n; i++) {
         out[i] = w->passive[i] ? w->colnorm[i] * w->centre[i] + col_dot(w->P, i, y) : 0.0;
@@ -1933,6 +1946,10 @@ int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *
         return tk_error_set(err, TK_EINVAL, "nnls: the proximal weight %g is not >= 0",
                             o.proximal);
     w.mu = o.proximal;
+    if (!(o.unrefined >= 0.0))
+        return tk_error_set(err, TK_EINVAL, "nnls: the weight without refinement %g is not >= 0",
+                            o.unrefined);
+    w.unrefined = o.unrefined;
     bool *guess = NULL;
     if ((o.warm_start || w.mu > 0.0) && n > 0) {
         guess = malloc(n * sizeof *guess);

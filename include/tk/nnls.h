@@ -72,9 +72,13 @@ typedef struct tk_nnls_options {
                                gives up: 0 the interior point where it is
                                expected to cost less than Lawson and Hanson,
                                1 always, -1 never */
+    double unrefined;       /* in the coordinate form, the proximal weight
+                               from which a passive solve takes no step of
+                               refinement (engine/nnls.c, primal_answer);
+                               0: every solve takes one */
 } tk_nnls_options;
 
-#define TK_NNLS_OPTIONS_INIT {0, 1e-10, 1e-14, false, 0.0, 0}
+#define TK_NNLS_OPTIONS_INIT {0, 1e-10, 1e-14, false, 0.0, 0, 0.0}
 
 typedef struct tk_nnls_report {
     int iterations;         /* pivoting iterations (and interior point
