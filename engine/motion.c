@@ -279,6 +279,7 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
     int most = cheap ? MOTION_PROXIMAL_KEPT_ROUNDS : MOTION_PROXIMAL_ROUNDS;
     nopt.unrefined = cheap ? MOTION_UNREFINED : 0.0;
     double used = nopt.proximal, dear = 0.0, t = 1.0;
+    bool recorded = false; /* x_last holds the round before's answer */
     for (int round = 0; !rc && round < most; round++) {
         used = nopt.proximal;
         rc = tk_nnls_solve(r->shared.nnls, a, work, r->motion.x, &nopt, &nr, err);
@@ -301,9 +302,10 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
             nopt.proximal *= MOTION_PROXIMAL_HALVE;
         nopt.proximal = fmax(nopt.proximal, MOTION_PROXIMAL_LEAST);
         /* (never after the last round: x leaves the loop as an answer) */
+        recorded = recorded && !shrinking;
         if (!shrinking && round + 1 < most) {
             double beta = 0.0;
-            if (nopt.proximal != used || nr.used_fallback || term > last || round == 0) {
+            if (nopt.proximal != used || nr.used_fallback || term > last || !recorded) {
                 t = 1.0;
             } else {
                 double next = 0.5 * (1.0 + sqrt(1.0 + 4.0 * t * t));
@@ -311,6 +313,7 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
                 t = next;
             }
             momentum(r, ncon, beta);
+            recorded = true;
         }
         last = term;
     }

@@ -648,7 +648,8 @@ typedef struct nnls_work {
     double rcond_floor;
     int max_iter;
     double mu;            /* the proximal weight (0: the plain problem) */
-    double unrefined;     /* opts->unrefined */
+    bool refined;         /* passive solves in the coordinate form take
+                             their step of refinement (opts->unrefined) */
     double *centre;       /* n: the proximal centre c (when mu > 0) */
     double *colnorm;      /* s_i = ||a_i|| */
     double *inv_norm;     /* 1 / s_i, 0 for zero columns */
@@ -885,8 +886,8 @@ static int primal_alloc(nnls_work *w, tk_error *err)
  * itself, not of z, so one step suffices (figures above).  The step is a
  * second solve with the factor, and where the factor is kept solves are
  * much of a flow step's time (bench/FIGURES.md, "Passive solves without
- * refinement"): from mu >= w->unrefined (when set) it is left out, which
- * the caller may ask where eps / mu is well below the KKT tolerance
+ * refinement"): from mu >= opts->unrefined (when set) it is left out,
+ * which the caller may ask where eps / mu is well below the KKT tolerance
  * (2e-11 of relative residual at 1e-6, above, against 1e-10). */
 static int primal_answer(nnls_work *w, cholmod_factor *L, double *out, tk_error *err)
 {
@@ -909,20 +910,20 @@ static int primal_answer(nnls_work *w, cholmod_factor *L, double *out, tk_error 
     if (rc != TK_OK)
         return rc;
     memcpy(y, sol, m * sizeof *y);
-    if (w->unrefined > 0.0 && w->mu >= w->unrefined) {
-        for (size_t i = 0; i < n; i++)
-            out[i] = w->passive[i]
-                         ? (w->colnorm[i] * w->centre[i] + col_dot(w->P, i, y)) * w->inv_norm[i]
-                         : 0.0;
-        return TK_OK;
-    }
     memset(v, 0, m * sizeof *v);
     for (size_t i = 0; i < n; i++) {
         out[i] = w->passive[i] ? w->colnorm[i] * w->centre[i] + col_dot(w->P, i, y) : 0.0;
+        if (!w->refined)
+            continue;
         size_t lo, hi;
         col_span(w->P, i, &lo, &hi);
         for (size_t e = lo; e < hi && out[i] != 0.0; e++)
             v[Pi[e]] += Px[e] * out[i];
+    }
+    if (!w->refined) {
+        for (size_t i = 0; i < n; i++)
+            out[i] *= w->inv_norm[i];
+        return TK_OK;
     }
     for (size_t i = 0; i < n; i++)
         h[i] = w->passive[i] ? w->ptb[i] - col_dot(w->P, i, v) +
@@ -1949,7 +1950,7 @@ int tk_nnls_solve(tk_nnls *s, const cholmod_sparse *A, const double *b, double *
     if (!(o.unrefined >= 0.0))
         return tk_error_set(err, TK_EINVAL, "nnls: the weight without refinement %g is not >= 0",
                             o.unrefined);
-    w.unrefined = o.unrefined;
+    w.refined = !(o.unrefined > 0.0 && w.mu >= o.unrefined);
     bool *guess = NULL;
     if ((o.warm_start || w.mu > 0.0) && n > 0) {
         guess = malloc(n * sizeof *guess);
