@@ -258,6 +258,7 @@ int tk_active_matrix(tk_run *r, const tk_curve *c, const tk_constraints *set,
             k += 2;
         }
     }
+    r->work.columns += (double)(set->struts.count + set->nkinks);
     r->active.matrix_seconds += tk_clock() - t0;
     return rc;
 }

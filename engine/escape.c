@@ -269,6 +269,7 @@ static int deformed(tk_run *r, const tk_curve *best, double thickness, bool far,
     double keep = far ? ESCAPE_FAR_THICKNESS : ESCAPE_THICKNESS;
     bool found = false;
     for (int size = 0; !rc && !found && size < ESCAPE_SIZES; size++, a *= ESCAPE_SHRINK) {
+        r->work.deforms += (double)best->nvert;
         tk_generate_fourier(*out, best, coef, ESCAPE_MODES, a);
         tk_curve_pins_snap(*out); /* a pinned vertex stays on its constraint */
         tk_measure m;
@@ -340,12 +341,13 @@ enum { TRY_TURNED, TRY_FAR, TRY_NEAR, TRY_KINDS };
  * on TURN_RESOLUTION vertices a unit of `rope` (8 a component at least),
  * into *out; TK_ENUMERIC when the turn is refused (a centre too near the
  * curve, or too few vertices to turn it). */
-static int turn(const tk_curve *c, const double offset[3], double rope, tk_curve **out,
-                tk_error *err)
+static int turn(tk_run *r, const tk_curve *c, const double offset[3], double rope,
+                tk_curve **out, tk_error *err)
 {
     size_t count = (size_t)(TURN_RESOLUTION * rope);
     if (count < 8 * c->ncomp)
         count = 8 * c->ncomp;
+    r->work.turns += (double)count * (double)count;
     tk_error why;
     int rc = tk_relax_turn(c, offset, count, TURN_STEPS, out, &why);
     if (rc == TK_ENOMEM)
@@ -381,7 +383,7 @@ static int try_curve(tk_run *r, const tk_curve *best, double thickness, double r
     if (index == TRY_TURNED) /* the first turn of the kind of tries: about the centroid */
         offset[0] = offset[1] = offset[2] = 0.0;
     *amplitude = 0.0;
-    int rc = turn(best, offset, rope, out, err);
+    int rc = turn(r, best, offset, rope, out, err);
     /* refused: a far deformation instead */
     *turned = rc == TK_OK;
     return rc == TK_ENUMERIC ? deformed(r, best, thickness, true, out, amplitude, err) : rc;
@@ -521,7 +523,7 @@ static tk_escape *log_entry(tk_run *r, tk_error *err)
 static int turned_start(tk_run *r, tk_curve **out, tk_error *err)
 {
     static const double centroid[3] = {0.0, 0.0, 0.0};
-    return r->escape.start ? turn(r->escape.start, centroid, r->escape.explored_rope, out, err)
+    return r->escape.start ? turn(r, r->escape.start, centroid, r->escape.explored_rope, out, err)
                            : TK_ENUMERIC;
 }
 

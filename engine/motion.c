@@ -285,6 +285,8 @@ int tk_motion_resolve(tk_run *r, tk_step_report *rep, bool equalise, tk_error *e
         rc = tk_nnls_solve(r->shared.nnls, a, work, r->motion.x, &nopt, &nr, err);
         r->motion.nnls_iterations += nr.iterations;
         r->motion.factorisations += nr.factorisations;
+        r->work.pivots += (double)nr.iterations * (double)(n3 + ncon);
+        r->work.factors += (double)nr.factorisations * (double)(n3 + ncon);
         r->motion.kept = !rc && nr.kept;
         double term = fabs(nr.proximal_term), res2 = nr.residual * nr.residual;
         bool shrinking = !large || !nr.kept;

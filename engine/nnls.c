@@ -129,6 +129,7 @@ struct tk_nnls {
     double order_lnz;     /* the entries of L it gave */
     unsigned long clock;
     cholmod_dense *X, *Y, *E;  /* cholmod_solve2's result and workspace */
+    tk_nnls_work work;    /* done so far (tk_nnls_work_done) */
 };
 
 /* The outcome of one (possibly regularised) factorisation. */
@@ -457,6 +458,26 @@ static double factor_rcond(const cholmod_factor *L)
     return L->is_ll ? r * r : r;
 }
 
+/* The floating-point operations of a numeric factorisation, about: the
+ * squares of the factor's column counts (a supernode's columns each with
+ * its rows) summed. */
+static double factor_flops(const cholmod_factor *L)
+{
+    double fl = 0.0;
+    if (L->is_super) {
+        const int *super = L->super, *pi = L->pi;
+        for (size_t sn = 0; sn < L->nsuper; sn++) {
+            double rows = (double)(pi[sn + 1] - pi[sn]);
+            fl += (double)(super[sn + 1] - super[sn]) * rows * rows;
+        }
+    } else if (L->nz) {
+        const int *nz = L->nz;
+        for (size_t j = 0; j < L->n; j++)
+            fl += (double)nz[j] * (double)nz[j];
+    }
+    return fl;
+}
+
 /* One numeric factorisation of T T' + delta I (of T's columns fset only,
  * when given); *rcond gets the estimate (0 when CHOLMOD found the matrix
  * not positive definite). */
@@ -467,6 +488,7 @@ static int factor_once(tk_nnls *s, const cholmod_sparse *T, const int *fset, siz
     cholmod_factorize_p((cholmod_sparse *)T, b, (int *)fset, fsize, L, &s->cc);
     if (s->cc.status < CHOLMOD_OK)
         return cholmod_failure(s, "factorize", err);
+    s->work.factor_flops += factor_flops(L);
     *rcond = s->cc.status == CHOLMOD_NOT_POSDEF ? 0.0 : factor_rcond(L);
     return TK_OK;
 }
@@ -625,6 +647,11 @@ void tk_nnls_free(tk_nnls **p)
 cholmod_common *tk_nnls_common(tk_nnls *s)
 {
     return s ? &s->cc : NULL;
+}
+
+tk_nnls_work tk_nnls_work_done(const tk_nnls *s)
+{
+    return s->work;
 }
 
 static size_t matrix_nnz(const cholmod_sparse *A)
@@ -1851,6 +1878,7 @@ static int interior_point(nnls_work *w, bool *guess, tk_error *err)
             rc = cholmod_failure(w->s, "factorize", err);
             break;
         }
+        w->s->work.factor_flops += factor_flops(w->pL);
         w->rep.factorisations++;
         w->rep.iterations++;
         w->rep.interior_steps++;
@@ -2107,6 +2135,7 @@ static int metric_solve(tk_nnls *s, const cholmod_sparse *P, const cholmod_spars
         rc = cholmod_failure(s, "factorize", err);
         goto done;
     }
+    s->work.factor_flops += factor_flops(L);
     if (s->cc.status == CHOLMOD_NOT_POSDEF || !(factor_rcond(L) > 0.0)) {
         rc = tk_error_set(err, TK_ENUMERIC, "nnls: the damped step's matrix (order %zu) is "
                           "not positive definite", m);

@@ -78,6 +78,36 @@ double tk_run_clock(const tk_run *r)
     return r->life.cpu_spent + (thread_clock() - r->life.cpu_entered);
 }
 
+/* What each counted operation cost the reference processor, in seconds a
+ * unit (tk_work, tk_nnls_work): a least-squares fit of the processor
+ * time of 200-step stretches of ten runs (catalogue 2.2.1, 3.1, 4.1,
+ * 6.3.2, 7.4, 8.2.4, 9.23 and 10.124 at resolution 5, 30 s each; 3.1 at
+ * 2,400 and 5.1 at 1,200 vertices, 60 s each) on the machine of
+ * bench/FIGURES.md ("A budget of work").  Each run's work came within 6%
+ * below to 22% above its seconds there, each of its levels within 27%
+ * below to 47% above.  The counts that got no weight in that fit (the
+ * contacts searched, the steps' vertices, the solves with a factor) are
+ * not counted: what they cost grew with the columns. */
+#define WORK_CHECK 1.63e-8      /* a vertex of a curve checked */
+#define WORK_COLUMN 2.84e-6     /* a column of a rigidity matrix */
+#define WORK_PIVOT 1.05e-7      /* an NNLS iteration, a unit of its size */
+#define WORK_FACTOR 7.24e-8     /* an NNLS factorisation, a unit of its size */
+#define WORK_NEWTON 8.98e-7     /* a recovery solve, a unit of its size */
+#define WORK_TURN 9.71e-5       /* a turn, a squared vertex */
+#define WORK_DEFORM 1.36e-6     /* a deformation, a vertex */
+#define WORK_FLOP 4.49e-10      /* a factorisation's floating-point operation */
+
+double tk_run_work(const tk_run *r)
+{
+    const tk_work *w = &r->work;
+    tk_nnls_work nw = {0};
+    if (r->shared.nnls)
+        nw = tk_nnls_work_done(r->shared.nnls);
+    return r->life.work_from + WORK_CHECK * w->checks + WORK_COLUMN * w->columns +
+           WORK_PIVOT * w->pivots + WORK_FACTOR * w->factors + WORK_NEWTON * w->newton +
+           WORK_TURN * w->turns + WORK_DEFORM * w->deforms + WORK_FLOP * nw.factor_flops;
+}
+
 void tk_run_clock_enter(tk_run *r)
 {
     r->life.cpu_entered = thread_clock();

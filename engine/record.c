@@ -130,6 +130,8 @@ double tk_options_spent(const tk_options *o, const tk_step_report *s)
         spent = (double)s->step / (double)o->max_steps;
     if (o->max_seconds > 0.0)
         spent = fmax(spent, s->seconds / o->max_seconds);
+    if (o->max_work > 0.0)
+        spent = fmax(spent, s->work / o->max_work);
     return spent;
 }
 
@@ -159,8 +161,9 @@ void tk_options_complete(tk_options *o, const tk_options_given *given)
         o->resolution = TK_DEFAULT_RESOLUTION;
     if (!given->autoscale)
         o->autoscale = true;
+    bool work = given->max_work && o->max_work > 0.0;
     if (!given->converge)
-        o->converge = !(given->max_seconds && o->max_seconds > 0.0);
-    if (!given->max_seconds)
+        o->converge = !(work || (given->max_seconds && o->max_seconds > 0.0));
+    if (!given->max_seconds && !work)
         o->max_seconds = TK_DEFAULT_SECONDS;
 }

@@ -93,6 +93,7 @@ int tk_recovery_violation(tk_run *r, const tk_curve *c, double *out, tk_error *e
         return TK_OK;
     }
     int rc = TK_OK;
+    r->work.checks += (double)c->nvert;
     if (!tk_strut_finder_closest_near(r->shared.finder, c, r->tau, &closest))
         rc = tk_strut_finder_closest_pair(r->shared.finder, c, TK_ARC_ADMISSIBLE, r->tau,
                                           r->tau, &closest, err);
@@ -316,6 +317,7 @@ static int damped_step(tk_run *r, const cholmod_sparse *a, const cholmod_sparse 
     double delta = 0.0;
     double t0 = tk_clock();
     *improved = false;
+    r->work.newton += (double)(a->nrow + a->ncol);
     int rc = tk_nnls_min_norm(r->shared.nnls, a, r->recovery.rhs, damping, metric,
                               r->recovery.du, &delta, err);
     r->recovery.nnls_seconds += tk_clock() - t0;
@@ -402,6 +404,7 @@ static int inequality_step(tk_run *r, double *worst, bool *improved, tk_error *e
         }
         bp[n] = (int)z;
         double t0 = tk_clock();
+        r->work.newton += (double)(m + n);
         rc = tk_nnls_solve(r->shared.nnls, b, rhs, y, NULL, NULL, err);
         r->recovery.nnls_seconds += tk_clock() - t0;
         if (rc == TK_ENUMERIC) /* y is the best found: the line search judges it */

@@ -99,6 +99,19 @@ typedef struct tk_known_kink {
     double force;
 } tk_known_kink;
 
+/* A run's work, counted in operations whose number depends on its path
+ * alone, not on the machine or its load (tk_run_work weighs them into
+ * seconds): each a sum over the operations of their sizes. */
+typedef struct tk_work {
+    double checks;    /* vertices of each curve checked for its violation */
+    double columns;   /* rigidity matrix columns built */
+    double pivots;    /* motion NNLS iterations x (3 vertices + constraints) */
+    double factors;   /* motion NNLS factorisations x (3 vertices + constraints) */
+    double newton;    /* recovery solves x (3 vertices + constraints) */
+    double turns;     /* vertices squared of each turn's relaxation */
+    double deforms;   /* vertices of each deformation tried */
+} tk_work;
+
 struct tk_run {
     /* set at creation, never changed */
     tk_options opt;
@@ -242,6 +255,8 @@ struct tk_run {
         int most;            /* escapes option, or 0 for a curve with an open component */
     } escape;
 
+    tk_work work;        /* counted where the operations are */
+
     struct {             /* tighten.c */
         tk_step_report latest;
         tk_step_report *history;
@@ -252,6 +267,7 @@ struct tk_run {
         double started;   /* tk_clock() at the start, less a resumed run's seconds */
         double cpu_spent; /* with cpu_time: the run's processor seconds before this call */
         double cpu_entered; /* the thread's processor clock where this call began */
+        double work_from; /* a resumed run's work before it (tk_run_work) */
         double flow_from; /* the flow's time at the start (a resumed run's) */
         tk_stop_reason stop;
         atomic_int cancel;
@@ -307,6 +323,13 @@ double tk_clock(void);
 double tk_run_clock(const tk_run *r);
 void tk_run_clock_enter(tk_run *r);
 void tk_run_clock_leave(tk_run *r);
+
+/* The run's work so far (a resumed run's before it included), in seconds
+ * of a reference processor: its operations (r->work and the NNLS
+ * solver's, tk_nnls_work_done) weighed by what each cost on that
+ * processor.  A function of the run's path alone, so that a budget of
+ * work (max_work) gives the same run on any machine at any load. */
+double tk_run_work(const tk_run *r);
 
 /* How much the ropelength fell over the last `window` entries of the
  * history, relative: the lowest over them below the lowest over the

@@ -21,6 +21,7 @@ const char *tk_stop_reason_name(tk_stop_reason r)
     case TK_STOP_STALLED: return "stalled";
     case TK_STOP_FAILED: return "failed";
     case TK_STOP_CONVERGED: return "converged";
+    case TK_STOP_WORK: return "work";
     }
     return "unknown";
 }
@@ -63,6 +64,7 @@ static int record(tk_run *r, tk_step_report *rep, tk_error *err)
     rep->escapes = tk_escape_tries(r);
     rep->restarts = r->schedule.restarts;
     rep->seconds = tk_run_clock(r);
+    rep->work = tk_run_work(r);
     /* the step sizes of the history summed: a step put back in the place
      * of the last (record_restored) has size 0 and the time of the one
      * before it */
@@ -146,6 +148,7 @@ static int create(const tk_curve *start, const tk_options *opts, const tk_resume
     /* a resumed run's clock goes on from the time it had spent */
     r->life.started = tk_clock() - (at ? at->seconds : 0.0);
     r->life.cpu_spent = at ? at->seconds : 0.0;
+    r->life.work_from = at ? at->work : 0.0;
     tk_run_clock_enter(r);
     r->life.flow_from = at ? at->flow_time : 0.0;
     tk_escape_start(r, at != NULL, start);
@@ -207,6 +210,7 @@ void tk_run_resume_point(const tk_run *r, tk_resume *out)
     memset(out, 0, sizeof *out);
     out->step = r->life.latest.step;
     out->seconds = r->life.latest.seconds;
+    out->work = r->life.latest.work;
     out->step_size = r->stepping.step_size;
     out->flow_time = r->life.latest.flow_time;
     tk_schedule_resume_point(r, out);
@@ -241,6 +245,8 @@ static void check_stop(tk_run *r)
         stop = TK_STOP_STEPS;
     else if (o->max_seconds > 0.0 && s->seconds >= o->max_seconds)
         stop = TK_STOP_TIME;
+    else if (o->max_work > 0.0 && s->work >= o->max_work)
+        stop = TK_STOP_WORK;
     else if (!tk_schedule_final(r))
         ; /* convergence is judged on the final polygon only */
     else if (o->min_residual > 0.0 && s->residual < o->min_residual)
@@ -265,7 +271,7 @@ static void check_stop(tk_run *r)
     if (tk_schedule_share_spent(r)) {
         tk_schedule_move_on(r);
         /* a stop on the budget has spent >= 1, above every share */
-        if (stop == TK_STOP_STEPS || stop == TK_STOP_TIME)
+        if (stop == TK_STOP_STEPS || stop == TK_STOP_TIME || stop == TK_STOP_WORK)
             stop = TK_STOP_NONE;
     }
     r->life.stop = stop;

@@ -71,11 +71,11 @@ START_TEST(json_options_round_trip)
 {
     tk_job_options o = TK_JOB_OPTIONS_INIT;
     json_t *in = json_pack("{s:f, s:i, s:i, s:f, s:f, s:f, s:f, s:b, s:i, s:i, s:i, s:b, s:f, s:f, "
-                           "s:b, s:b, s:i}",
+                           "s:b, s:b, s:f, s:i}",
                            "resolution", 5.0, "vertices", 0, "steps", 300, "time", 0.0, "residual", 0.01,
                            "radius", 0.5, "lambda", 2.0, "autoscale", 1, "every", 25, "escapes",
                            0, "seed", 7, "coarse", 0, "overstep", 2e-5, "re_resolve", 0.0,
-                           "converge", 1, "cpu_time", 1, "loose", 2);
+                           "converge", 1, "cpu_time", 1, "work", 1.5, "loose", 2);
     tk_error err;
     ck_assert_int_eq(tk_job_options_from_json(&o, in, NULL, &err), TK_OK);
     json_t *doc = tk_job_new("knot", NULL, &o, 1, 3);

@@ -7,6 +7,7 @@
 #include <check.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -1841,6 +1842,117 @@ START_TEST(cpu_time_counts_the_run_s_own_processor_time)
 }
 END_TEST
 
+/* A thread that keeps the caches and the memory bus busy (the load that
+ * cost a time-budgeted run a sixth of its steps beside other runs) until
+ * told to stop. */
+typedef struct {
+    atomic_int stop;
+    double sum;
+} load_state;
+
+static void *load_memory(void *arg)
+{
+    load_state *l = arg;
+    size_t n = (size_t)1 << 22; /* 32 MB of doubles */
+    double *buf = calloc(n, sizeof *buf);
+    for (unsigned pass = 0; buf && !atomic_load(&l->stop); pass++)
+        for (size_t i = 0; i < n; i += 8)
+            buf[i] += (double)pass, l->sum += buf[i];
+    free(buf);
+    return NULL;
+}
+
+/* One run of `c` to a work budget; its history and curve into *h, *nh
+ * and *out (the caller frees them). */
+static void run_to_work(const tk_curve *c, const tk_options *o, bool sleepy,
+                        tk_step_report **h, size_t *nh, tk_curve **out)
+{
+    tk_run *run = NULL;
+    long steps = 0;
+    ck_assert_int_eq(tk_run_new(c, o, &run, NULL), TK_OK);
+    if (sleepy)
+        tk_run_set_progress(run, sleep_step, &steps);
+    tk_stop_reason why;
+    ck_assert_int_eq(tk_run_until(run, &why, NULL), TK_OK);
+    ck_assert_int_eq(why, TK_STOP_WORK);
+    const tk_step_report *hist = tk_run_history(run, nh);
+    *h = malloc(*nh * sizeof **h);
+    memcpy(*h, hist, *nh * sizeof **h);
+    ck_assert_int_eq(tk_curve_copy(tk_run_curve(run), out, NULL), TK_OK);
+    printf("work budget %.2f: %zu steps, work %.4f in %.3f s, ropelength %.6f%s\n", o->max_work,
+           *nh - 1, (*h)[*nh - 1].work, (*h)[*nh - 1].seconds, (*h)[*nh - 1].ropelength,
+           sleepy ? " (sleeping 3 ms a step, memory loaded)" : "");
+    tk_run_free(&run);
+}
+
+/* A budget of work names one run: the same start and options tighten
+ * step for step alike, bit for bit, whether the run has the machine to
+ * itself or sleeps after every step while another thread loads the
+ * memory (a time budget, wall or processor, ends elsewhere under such
+ * load).  The work counts up with every step, and the run stops at the
+ * first step that reaches the budget; a resumed run goes on from the work
+ * it had done. */
+START_TEST(a_work_budget_gives_the_same_run_at_any_load)
+{
+    tk_curve *c = NULL;
+    ck_assert_int_eq(tk_generate_torus(2, 3, 120, &c, NULL), TK_OK);
+    tk_options o = TK_OPTIONS_INIT;
+    o.autoscale = true;
+    o.resolution = 5.0;
+    o.max_work = 1.5;
+    tk_step_report *ha = NULL, *hb = NULL;
+    size_t na = 0, nb = 0;
+    tk_curve *a = NULL, *b = NULL;
+    run_to_work(c, &o, false, &ha, &na, &a);
+    load_state load = {.sum = 0.0};
+    atomic_init(&load.stop, 0);
+    pthread_t loader;
+    ck_assert_int_eq(pthread_create(&loader, NULL, load_memory, &load), 0);
+    run_to_work(c, &o, true, &hb, &nb, &b);
+    atomic_store(&load.stop, 1);
+    pthread_join(loader, NULL);
+    /* through the coarse levels, whose shares the budget sets */
+    ck_assert_uint_ge(na, 100);
+    ck_assert_uint_lt(ha[0].vertices, ha[na - 1].vertices);
+    ck_assert_uint_eq(na, nb);
+    for (size_t k = 0; k < na; k++) {
+        ck_assert_msg(ha[k].ropelength == hb[k].ropelength && ha[k].work == hb[k].work &&
+                          ha[k].vertices == hb[k].vertices,
+                      "step %ld: ropelength %.17g against %.17g, work %.17g against %.17g",
+                      ha[k].step, ha[k].ropelength, hb[k].ropelength, ha[k].work, hb[k].work);
+        if (k > 0)
+            ck_assert(ha[k].work >= ha[k - 1].work);
+    }
+    ck_assert_uint_eq(a->nvert, b->nvert);
+    ck_assert(!memcmp(a->xyz, b->xyz, 3 * a->nvert * sizeof *a->xyz));
+    /* the first step at the budget stops it */
+    ck_assert(ha[na - 1].work >= o.max_work);
+    ck_assert(ha[na - 2].work < o.max_work);
+    /* a resumed run counts on from the work done */
+    tk_run *run = NULL;
+    ck_assert_int_eq(tk_run_new(c, &o, &run, NULL), TK_OK);
+    for (int k = 0; k < 50; k++)
+        ck_assert_int_eq(tk_run_step(run, NULL), TK_OK);
+    tk_resume at;
+    tk_run_resume_point(run, &at);
+    ck_assert(at.work == tk_run_latest(run)->work && at.work > 0.0);
+    tk_run *again = NULL;
+    ck_assert_int_eq(tk_run_resume(tk_run_curve(run), &o, &at, NULL, NULL,
+                                   tk_run_type_start(run), &again, NULL),
+                     TK_OK);
+    ck_assert(tk_run_latest(again)->work >= at.work);
+    ck_assert_int_eq(tk_run_step(again, NULL), TK_OK);
+    ck_assert(tk_run_latest(again)->work > at.work);
+    tk_run_free(&again);
+    tk_run_free(&run);
+    free(ha);
+    free(hb);
+    tk_curve_free(&a);
+    tk_curve_free(&b);
+    tk_curve_free(&c);
+}
+END_TEST
+
 /* The type is checked where the flow's constraints do not hold it: a
  * trefoil resampled to 4 vertices is an unknot, and the run is refused
  * with the reason; a run that keeps its type reports it, start and
@@ -3379,6 +3491,7 @@ int main(void)
     tcase_add_test(tc, history_and_snapshots);
     tcase_add_test(tc, timing_accounts_for_the_run);
     tcase_add_test(tc, cpu_time_counts_the_run_s_own_processor_time);
+    tcase_add_test(tc, a_work_budget_gives_the_same_run_at_any_load);
     tcase_add_test(tc, the_knot_type_is_checked);
     tcase_add_test(tc, escapes_keep_the_best_and_repeat);
     tcase_add_test(tc, a_resumed_run_goes_on_where_it_was);

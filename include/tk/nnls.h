@@ -116,6 +116,16 @@ void tk_nnls_free(tk_nnls **p);
 /* The solver's cholmod_common, for allocating matrices passed to it. */
 cholmod_common *tk_nnls_common(tk_nnls *s);
 
+/* The work a solver has done, summed over its calls: counts of the
+ * operations that depend on the problems alone, not on the machine (the
+ * pivoting iterations and factorisations are in the reports). */
+typedef struct tk_nnls_work {
+    double factor_flops;     /* numeric factorisations: the squares of the
+                                factor's column counts summed */
+} tk_nnls_work;
+
+tk_nnls_work tk_nnls_work_done(const tk_nnls *s);
+
 /* Solves the NNLS problem.  A is m x n (A->stype == 0, packed, real); b has
  * m entries; x receives n entries.  opts may be NULL for the defaults;
  * report may be NULL.  Returns TK_OK, or TK_ENUMERIC when no answer

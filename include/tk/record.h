@@ -73,7 +73,7 @@ int tk_field_parse(const tk_field *f, void *record, const char *text, tk_error *
  * other (re_resolve and snapshots exclude each other). */
 int tk_options_check(const tk_options *o, tk_error *err);
 
-/* The share of its budget (steps, time: the larger share) a run has
+/* The share of its budget (steps, time, work: the largest share) a run has
  * spent at the step report s, not capped at 1; -1 when it has no budget. */
 double tk_options_spent(const tk_options *o, const tk_step_report *s);
 
@@ -94,8 +94,9 @@ bool tk_options_given_mark(tk_options_given *g, const char *name);
  * meant to end tight; of the options the user did not give, it goes coarse
  * to fine at TK_DEFAULT_RESOLUTION (unless a resolution or a vertex count
  * was given), autoscales (a start thinner than the tube can run no other
- * way), is capped at TK_DEFAULT_SECONDS, and stops when converged unless a
- * time was given (a time given is run out, as before these defaults).
+ * way), is capped at TK_DEFAULT_SECONDS unless it was given work, and
+ * stops when converged unless a time or work was given (a budget given is
+ * run out, as before these defaults).
  * Options given keep their values; any other run is left as given. */
 void tk_options_complete(tk_options *o, const tk_options_given *given);
 

@@ -95,6 +95,11 @@
     X(cpu_time, BOOL, false, 0, 1, "cpu_time",                                               \
       "count the seconds (--time, and those reported) in the run's own processor time, not " \
       "the wall clock's: on a busy machine a run then does the work it does on an idle one") \
+    X(max_work, REAL, 0.0, 0.0, 604800, "work",                                              \
+      "stop after this much work, in seconds of a reference processor (at most a week; 0: "  \
+      "no limit): the work is counted from the run's own operations, so the same start, "    \
+      "options and seed give the same run, step for step, on any machine at any load, "      \
+      "where a budget of seconds gives another run on each")                                 \
     X(min_residual, REAL, 0.0, 0.0, 1.0, "residual",                                         \
       "stop when the residual |resolved gradient| / |gradient| falls below this (0: "        \
       "never)")                                                                              \
@@ -179,7 +184,8 @@ typedef enum tk_stop_reason {
     TK_STOP_CANCELLED,
     TK_STOP_STALLED,       /* the step size fell to nothing */
     TK_STOP_FAILED,        /* numerical failure: see the error message */
-    TK_STOP_CONVERGED      /* as far as its tolerances allow (converge) */
+    TK_STOP_CONVERGED,     /* as far as its tolerances allow (converge) */
+    TK_STOP_WORK           /* the work budget (max_work) */
 } tk_stop_reason;
 
 const char *tk_stop_reason_name(tk_stop_reason r);
@@ -189,6 +195,8 @@ const char *tk_stop_reason_name(tk_stop_reason r);
 #define TK_STEP_FIELDS(X)                                                                    \
     X(step, LONG, 0, 0, 0, "step", "1 for the first step; 0 for the start")                 \
     X(seconds, REAL, 0, 0, 0, "seconds", "wall time since the run started")                 \
+    X(work, REAL, 0, 0, 0, "work",                                                          \
+      "work done since the run started, in seconds of a reference processor (tk_run_work)")  \
     X(ropelength, REAL, 0, 0, 0, "ropelength", "2 length / thickness (Definition 1)")       \
     X(length, REAL, 0, 0, 0, "length", "of the curve")                                      \
     X(thickness, REAL, 0, 0, 0, "thickness", "the tube diameter (Definition 1)")            \
@@ -351,6 +359,7 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out);
 #define TK_RESUME_FIELDS(X)                                                                  \
     X(step, LONG, 0, 0, 9e15, "step", "steps taken")                                        \
     X(seconds, REAL, 0, 0, 1e12, "seconds", "wall time spent")                              \
+    X(work, REAL, 0, 0, 1e12, "work", "work done (tk_run_work)")                             \
     X(start_ropelength, REAL, 0, 0, 1e300, "start_ropelength",                              \
       "the ropelength of the input, before any resampling")                                  \
     X(coarse_level, INT, 0, 0, 64, "coarse_level", "halvings of the vertex count still to "  \
