@@ -88,7 +88,7 @@ BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 
 .SECONDARY:
 
-.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-starts bench-service bench-cluster bench-catalogue bench-jones bench-extrapolate \
+.PHONY: all deps test test-unit test-asan test-cli run bench bench-struts bench-tighten bench-steps bench-starts bench-service bench-cluster bench-work bench-catalogue bench-jones bench-extrapolate \
 	lint headers clean fuzz fuzz-bin
 
 WEB_OUT := $(BUILD)/web
@@ -199,7 +199,7 @@ run: deps all
 	@echo "tightknot: starting the service on http://127.0.0.1:$(PORT)/ (Ctrl-C stops it)"
 	$(Q)exec $(DAEMON) $(RUN_ARGS)
 
-bench: bench-struts bench-tighten bench-steps bench-starts bench-service bench-cluster
+bench: bench-struts bench-tighten bench-steps bench-starts bench-service bench-cluster bench-work
 
 bench-struts: deps all $(BENCH_BIN)
 	$(Q)$(BUILD)/bench/struts $(CATALOGUE)
@@ -218,6 +218,11 @@ bench-service: deps all
 
 bench-cluster: deps all
 	$(Q)node bench/cluster.mjs $(BUILD) $(CATALOGUE)
+
+# A budget of work against the processor time it takes here, and the same
+# run again beside a copy of itself.
+bench-work: deps all
+	$(Q)./bench/work.sh 20 $(BUILD) $(CATALOGUE)
 
 # The whole catalogue through the service (hours: see README, --slice).
 bench-catalogue: deps all

@@ -39,9 +39,11 @@
 //                     OUT/jobs.db, one worker per core)
 //   --token TOKEN     for a daemon with --tokens
 //   --slice K/N       the K-th of N slices (default 1/1: all)
-//   --seconds S       processor time per start (default 60): each job's
-//                     own (cpu_time), so that a slice run beside other
-//                     work gives each start what it gets on an idle machine
+//   --work W          work per start, in seconds of the reference processor
+//                     (tightknot tighten --work; default 60): counted from
+//                     the run's own operations, so a start ends where it
+//                     would on an idle machine whatever else runs beside
+//                     it, and run again ends there again
 //   --resolution R    vertices per unit ropelength (default 5)
 //   --far K           far starts per knot (generate wander), seeds 1..K (default 1)
 //   --turn K          turned starts per knot, seeds 0..K-1 (default 1)
@@ -70,7 +72,7 @@ import { fileURLToPath } from 'node:url';
 
 const argv = process.argv.slice(2);
 const opt = {
-    server: null, token: process.env.TIGHTKNOT_TOKEN ?? null, slice: '1/1', seconds: 60,
+    server: null, token: process.env.TIGHTKNOT_TOKEN ?? null, slice: '1/1', work: 60,
     resolution: 5, far: 1, turn: 1, parallel: cpus().length, out: 'build/catalogue',
     table: 'docs/catalogue.tsv', build: 'build', only: null, tableOnly: false, loose: 2, engine: null,
     workerPriority: 'normal',
@@ -85,7 +87,7 @@ for (let i = 0; i < argv.length; i++) {
     if (a === '--server') opt.server = value();
     else if (a === '--token') opt.token = value();
     else if (a === '--slice') opt.slice = value();
-    else if (a === '--seconds') opt.seconds = Number(value());
+    else if (a === '--work') opt.work = Number(value());
     else if (a === '--resolution') opt.resolution = Number(value());
     else if (a === '--far') opt.far = Number(value());
     else if (a === '--turn') opt.turn = Number(value());
@@ -104,7 +106,7 @@ for (let i = 0; i < argv.length; i++) {
 }
 const slice = /^(\d+)\/(\d+)$/.exec(opt.slice);
 if (!slice || +slice[1] < 1 || +slice[1] > +slice[2]) usage(`--slice ${opt.slice}: expected K/N, 1 <= K <= N`);
-for (const k of ['seconds', 'resolution', 'parallel'])
+for (const k of ['work', 'resolution', 'parallel'])
     if (!(opt[k] > 0)) usage(`--${k} must be positive`);
 if (!(Number.isInteger(opt.far) && opt.far >= 0)) usage('--far must be a whole number >= 0');
 if (!(Number.isInteger(opt.turn) && opt.turn >= 0)) usage('--turn must be a whole number >= 0');
@@ -112,7 +114,7 @@ if (!(Number.isInteger(opt.loose) && opt.loose >= 0 && opt.loose <= 2)) usage('-
 if (!['normal', 'low', 'idle'].includes(opt.workerPriority)) usage('--worker-priority must be normal, low or idle');
 // the settings a slice ran with, kept beside its results: the table's
 // rows carry their own slice's
-const settingsText = (loose, engine) => `resolution ${opt.resolution}, ${opt.seconds} s of processor time `
+const settingsText = (loose, engine) => `resolution ${opt.resolution}, ${opt.work} s of work `
     + `a start, autoscale, default escapes${loose ? `, loose ${loose}` : ''}${engine ? `, engine ${engine}` : ''}`;
 if (opt.engine === null) {
     const git = spawnSync('git', ['log', '-1', '--format=%h', '--', 'engine', 'include/tk'],
@@ -267,7 +269,7 @@ async function submitAll(server, files) {
     // autoscale: a deformed start is thinner than the tube (ropelength
     // does not depend on the scale)
     const args = ['remote', '--server', server, 'submit', '--resolution', String(opt.resolution),
-        '--time', String(opt.seconds), '--cpu-time', '--autoscale', '--parallel', String(opt.parallel),
+        '--work', String(opt.work), '--autoscale', '--parallel', String(opt.parallel),
         '--loose', String(opt.loose), '--out', resultsDir, ...files];
     if (opt.token) args.splice(3, 0, '--token', opt.token);
     const child = spawn(CLI, args, { stdio: 'inherit' });
@@ -473,7 +475,7 @@ if (!opt.tableOnly) {
         `starts in ${startsDir}`);
     const files = [];
     for (const name of mine) files.push(...makeStarts(name));
-    console.log(`bench/catalogue: ${files.length} starts; resolution ${opt.resolution}, ${opt.seconds} s each, ` +
+    console.log(`bench/catalogue: ${files.length} starts; resolution ${opt.resolution}, ${opt.work} s of work each, ` +
         `${opt.parallel} at once`);
     let daemon = null;
     const server = opt.server ?? (daemon = await ownDaemon()).url;

@@ -79,7 +79,7 @@ double tk_run_clock(const tk_run *r)
 }
 
 /* What each counted operation cost the reference processor, in seconds a
- * unit (tk_work, tk_nnls_work): a least-squares fit of the processor
+ * unit (tk_work_counts): a least-squares fit of the processor
  * time of 200-step stretches of ten runs (catalogue 2.2.1, 3.1, 4.1,
  * 6.3.2, 7.4, 8.2.4, 9.23 and 10.124 at resolution 5, 30 s each; 3.1 at
  * 2,400 and 5.1 at 1,200 vertices, 60 s each) on the machine of
@@ -97,15 +97,20 @@ double tk_run_clock(const tk_run *r)
 #define WORK_DEFORM 1.36e-6     /* a deformation, a vertex */
 #define WORK_FLOP 4.49e-10      /* a factorisation's floating-point operation */
 
+void tk_run_work_counts(const tk_run *r, tk_work_counts *out)
+{
+    *out = r->work;
+    if (r->shared.nnls)
+        out->flops = tk_nnls_work_done(r->shared.nnls).factor_flops;
+}
+
 double tk_run_work(const tk_run *r)
 {
-    const tk_work *w = &r->work;
-    tk_nnls_work nw = {0};
-    if (r->shared.nnls)
-        nw = tk_nnls_work_done(r->shared.nnls);
-    return r->life.work_from + WORK_CHECK * w->checks + WORK_COLUMN * w->columns +
-           WORK_PIVOT * w->pivots + WORK_FACTOR * w->factors + WORK_NEWTON * w->newton +
-           WORK_TURN * w->turns + WORK_DEFORM * w->deforms + WORK_FLOP * nw.factor_flops;
+    tk_work_counts w;
+    tk_run_work_counts(r, &w);
+    return r->life.work_from + WORK_CHECK * w.checks + WORK_COLUMN * w.columns +
+           WORK_PIVOT * w.pivots + WORK_FACTOR * w.factors + WORK_NEWTON * w.newton +
+           WORK_TURN * w.turns + WORK_DEFORM * w.deforms + WORK_FLOP * w.flops;
 }
 
 void tk_run_clock_enter(tk_run *r)

@@ -99,19 +99,6 @@ typedef struct tk_known_kink {
     double force;
 } tk_known_kink;
 
-/* A run's work, counted in operations whose number depends on its path
- * alone, not on the machine or its load (tk_run_work weighs them into
- * seconds): each a sum over the operations of their sizes. */
-typedef struct tk_work {
-    double checks;    /* vertices of each curve checked for its violation */
-    double columns;   /* rigidity matrix columns built */
-    double pivots;    /* motion NNLS iterations x (3 vertices + constraints) */
-    double factors;   /* motion NNLS factorisations x (3 vertices + constraints) */
-    double newton;    /* recovery solves x (3 vertices + constraints) */
-    double turns;     /* vertices squared of each turn's relaxation */
-    double deforms;   /* vertices of each deformation tried */
-} tk_work;
-
 struct tk_run {
     /* set at creation, never changed */
     tk_options opt;
@@ -255,7 +242,8 @@ struct tk_run {
         int most;            /* escapes option, or 0 for a curve with an open component */
     } escape;
 
-    tk_work work;        /* counted where the operations are */
+    tk_work_counts work; /* counted where the operations are (the flops
+                            by the NNLS solver, tk_nnls_work_done) */
 
     struct {             /* tighten.c */
         tk_step_report latest;
@@ -330,6 +318,8 @@ void tk_run_clock_leave(tk_run *r);
  * processor.  A function of the run's path alone, so that a budget of
  * work (max_work) gives the same run on any machine at any load. */
 double tk_run_work(const tk_run *r);
+/* Its counts, the NNLS solver's flops included. */
+void tk_run_work_counts(const tk_run *r, tk_work_counts *out);
 
 /* How much the ropelength fell over the last `window` entries of the
  * history, relative: the lowest over them below the lowest over the

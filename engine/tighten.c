@@ -456,6 +456,7 @@ void tk_run_timing_get(const tk_run *r, tk_run_timing *out)
         .corrected_steps = r->stepping.corrected_steps,
         .largest_rescale = r->recovery.largest_rescale,
     };
+    tk_run_work_counts(r, &out->work);
 }
 
 const tk_invariants *tk_run_type_start(const tk_run *r)

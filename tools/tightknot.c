@@ -1016,8 +1016,8 @@ typedef struct tighten_watch {
 
 /* The share of the budget spent and the time left, when the run has a
  * budget: "37% of the budget, 76 s left"; a time budget bounds what is
- * left (a run that converges stops sooner), steps are reckoned at the
- * pace so far. */
+ * left (a run that converges stops sooner), steps and work are reckoned
+ * at the pace so far. */
 static void budget_text(const tk_options *o, const tk_step_report *s, char *buf, size_t n)
 {
     double f = tk_options_spent(o, s);
@@ -1029,6 +1029,8 @@ static void budget_text(const tk_options *o, const tk_step_report *s, char *buf,
         left = o->max_seconds - s->seconds;
     if (o->max_steps > 0 && s->step > 0)
         left = fmin(left, s->seconds * (double)(o->max_steps - s->step) / (double)s->step);
+    if (o->max_work > 0.0 && s->work > 0.0)
+        left = fmin(left, s->seconds * (o->max_work - s->work) / s->work);
     int len = snprintf(buf, n, "  %3.0f%% of the budget", 100.0 * fmin(f, 1.0));
     if (isfinite(left) && len > 0 && (size_t)len < n)
         snprintf(buf + len, n - (size_t)len, ", %s%.0f s left",
@@ -1058,6 +1060,8 @@ static void stops_text(const tk_options *o, char *buf, size_t n)
         STOP_PART("after %ld steps", o->max_steps);
     if (o->max_seconds > 0.0)
         STOP_PART("after %g s (--time)", o->max_seconds);
+    if (o->max_work > 0.0)
+        STOP_PART("after %g s of work (--work)", o->max_work);
 #undef STOP_PART
 }
 

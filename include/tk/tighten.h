@@ -322,6 +322,21 @@ const tk_invariants *tk_run_type_latest(const tk_run *r);
       "thickness their violation leaves rose, and fell once the violation was corrected "    \
       "(section 4.6)")
 
+/* A run's work (the step report's), counted in operations whose number
+ * depends on the run's path alone, not on the machine or its load: each
+ * a sum over the operations of their sizes, weighed into seconds of a
+ * reference processor by what each cost it (engine/queries.c). */
+typedef struct tk_work_counts {
+    double checks;    /* vertices of each curve checked for its violation */
+    double columns;   /* rigidity matrix columns built */
+    double pivots;    /* motion NNLS iterations x (3 vertices + constraints) */
+    double factors;   /* motion NNLS factorisations x (3 vertices + constraints) */
+    double newton;    /* recovery solves x (3 vertices + constraints) */
+    double turns;     /* vertices squared of each turn's relaxation */
+    double deforms;   /* vertices of each deformation tried */
+    double flops;     /* NNLS factorisations' floating-point operations */
+} tk_work_counts;
+
 /* Where a run's wall time went, in seconds.  The first four are the
  * operations every step repeats, wherever in the flow they happen;
  * `total` is all of tk_run_new and tk_run_step (the rest of it is the
@@ -343,6 +358,8 @@ typedef struct tk_run_timing {
     long nnls_solves, nnls_iterations, factorisations;
     double invariants;   /* the knot type computed and compared (included
                             in total) */
+    tk_work_counts work; /* the operations counted, as the step's work
+                            weighs them (a resumed run's since its resume) */
     TK_RECOVERY_FIELDS(TK_FIELD_DECLARE)
 } tk_run_timing;
 
