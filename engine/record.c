@@ -161,9 +161,9 @@ void tk_options_complete(tk_options *o, const tk_options_given *given)
         o->resolution = TK_DEFAULT_RESOLUTION;
     if (!given->autoscale)
         o->autoscale = true;
-    bool work = given->max_work && o->max_work > 0.0;
     if (!given->converge)
-        o->converge = !(work || (given->max_seconds && o->max_seconds > 0.0));
-    if (!given->max_seconds && !work)
-        o->max_seconds = TK_DEFAULT_SECONDS;
+        o->converge = !((given->max_seconds && o->max_seconds > 0.0) ||
+                        (given->max_work && o->max_work > 0.0));
+    if (!given->max_seconds && !given->max_work)
+        o->max_work = TK_DEFAULT_WORK;
 }

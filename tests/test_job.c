@@ -129,7 +129,8 @@ START_TEST(no_stop_criterion_means_the_defaults_that_tighten)
     tk_job_options o = TK_JOB_OPTIONS_INIT;
     tk_job_options_complete(&o);
     ck_assert_int_eq(o.run.max_steps, 0);
-    ck_assert(o.run.max_seconds == TK_DEFAULT_SECONDS && o.run.converge && o.run.autoscale);
+    ck_assert(o.run.max_work == TK_DEFAULT_WORK && o.run.max_seconds == 0.0 && o.run.converge &&
+              o.run.autoscale);
     ck_assert(o.run.resolution == TK_DEFAULT_RESOLUTION && o.run.vertices == 0);
     tk_error err;
     o = (tk_job_options)TK_JOB_OPTIONS_INIT;
@@ -139,22 +140,31 @@ START_TEST(no_stop_criterion_means_the_defaults_that_tighten)
     tk_job_options_complete(&o);
     ck_assert_int_eq(o.run.max_steps, 0);
     ck_assert(o.run.max_seconds == 3.0 && o.run.radius == 2.0 && !o.run.converge);
+    ck_assert(o.run.max_work == 0.0); /* a time given: no cap of work */
     ck_assert(o.run.autoscale);
     ck_assert(o.run.vertices == 300 && o.run.resolution == 0.0); /* a count given: kept */
     /* what is given keeps its value, the default too: no autoscale, the
-     * input's vertices, no converge (a cap of 120 s still) */
+     * input's vertices, no converge (a cap of 120 of work still) */
     o = (tk_job_options)TK_JOB_OPTIONS_INIT;
     json_t *given = json_pack("{s:b, s:f, s:b}", "autoscale", 0, "resolution", 0.0, "converge", 0);
     ck_assert_int_eq(tk_job_options_from_json(&o, given, NULL, &err), TK_OK);
     json_decref(given);
     tk_job_options_complete(&o);
     ck_assert(!o.run.autoscale && o.run.resolution == 0.0 && !o.run.converge);
-    ck_assert(o.run.max_seconds == TK_DEFAULT_SECONDS);
-    /* a time of 0 given (no limit): converged, with no cap */
+    ck_assert(o.run.max_work == TK_DEFAULT_WORK && o.run.max_seconds == 0.0);
+    /* a time or work of 0 given (no limit): converged, with no cap */
+    const char *budgets[] = {"time", "work"};
+    for (int k = 0; k < 2; k++) {
+        o = (tk_job_options)TK_JOB_OPTIONS_INIT;
+        ck_assert_int_eq(tk_job_option_set_text(&o, budgets[k], "0", &err), TK_OK);
+        tk_job_options_complete(&o);
+        ck_assert(o.run.max_seconds == 0.0 && o.run.max_work == 0.0 && o.run.converge);
+    }
+    /* work given is run out, with no cap of time */
     o = (tk_job_options)TK_JOB_OPTIONS_INIT;
-    ck_assert_int_eq(tk_job_option_set_text(&o, "time", "0", &err), TK_OK);
+    ck_assert_int_eq(tk_job_option_set_text(&o, "work", "30", &err), TK_OK);
     tk_job_options_complete(&o);
-    ck_assert(o.run.max_seconds == 0.0 && o.run.converge);
+    ck_assert(o.run.max_work == 30.0 && o.run.max_seconds == 0.0 && !o.run.converge);
     /* the engine's own defaults stay for what a job does not set */
     tk_options defaults = TK_OPTIONS_INIT;
     ck_assert(o.run.overstep_tolerance == defaults.overstep_tolerance);
@@ -167,7 +177,8 @@ START_TEST(no_stop_criterion_means_the_defaults_that_tighten)
     tk_job_options none = TK_JOB_OPTIONS_INIT;
     json_t *doc = tk_job_new("knot", NULL, &none, 1, 3);
     json_t *opts = json_object_get(doc, "options");
-    ck_assert(json_real_value(json_object_get(opts, "time")) == TK_DEFAULT_SECONDS);
+    ck_assert(json_real_value(json_object_get(opts, "work")) == TK_DEFAULT_WORK);
+    ck_assert(json_real_value(json_object_get(opts, "time")) == 0.0);
     ck_assert(json_is_true(json_object_get(opts, "converge")));
     json_decref(doc);
 }

@@ -271,11 +271,13 @@ static const char tighten_help_end[] =
     "Defaults that tighten: with neither --steps nor --residual (the stops\n"
     "that end the flow at a chosen point, to compare runs) a run goes coarse\n"
     "to fine at --resolution 5 (unless a resolution or --vertices is given),\n"
-    "autoscales and tries its escapes; given no --time either, it stops when\n"
-    "it has converged as far as its tolerances allow, or after 120 s:\n"
-    "'tightknot tighten 4.1' ends at the tight figure-eight.  A --time is run\n"
-    "out (add --converge to stop sooner when converged).  With --steps or\n"
-    "--residual every option is as given.\n"
+    "autoscales and tries its escapes; given no --time or --work either, it\n"
+    "stops when it has converged as far as its tolerances allow, or after 120\n"
+    "of work (--work 120: about 120 s of a processor, and the same run on any\n"
+    "machine at any load): 'tightknot tighten 4.1' ends at the tight\n"
+    "figure-eight.  A --time or --work is run out (add --converge to stop\n"
+    "sooner when converged).  With --steps or --residual every option is as\n"
+    "given.\n"
     "\n"
     "Constraints on vertices (the file's own, '# Constraint K Plane a b c\n"
     "d' in its header and '# Cst: K' after a vertex, come first):\n"
@@ -1038,7 +1040,7 @@ static void budget_text(const tk_options *o, const tk_step_report *s, char *buf,
 }
 
 /* How a run with these options stops, in words: "when converged or after
- * 120 s", the options' stop criteria in the order they are judged. */
+ * 120 s of work", the options' stop criteria in the order they are judged. */
 static void stops_text(const tk_options *o, char *buf, size_t n)
 {
     size_t len = 0;
@@ -1066,7 +1068,7 @@ static void stops_text(const tk_options *o, char *buf, size_t n)
 }
 
 /* What a run was given, in words: "resolution 5, autoscale, stops when
- * converged or after 120 s (--time)". */
+ * converged or after 120 s of work (--work)". */
 static void settings_text(const tk_options *o, char *buf, size_t n)
 {
     char stops[160], count[64] = "";

@@ -250,7 +250,7 @@ function readOptions() {
     };
     num('opt-resolution', 'resolution');
     num('opt-steps', 'steps');
-    num('opt-time', 'time');
+    num('opt-work', 'work');
     num('opt-residual', 'residual');
     num('opt-every', 'every');
     num('opt-radius', 'radius');

@@ -94,9 +94,9 @@ bool tk_options_given_mark(tk_options_given *g, const char *name);
  * meant to end tight; of the options the user did not give, it goes coarse
  * to fine at TK_DEFAULT_RESOLUTION (unless a resolution or a vertex count
  * was given), autoscales (a start thinner than the tube can run no other
- * way), is capped at TK_DEFAULT_SECONDS unless it was given work, and
- * stops when converged unless a time or work was given (a budget given is
- * run out, as before these defaults).
+ * way), is capped at TK_DEFAULT_WORK of work unless it was given a time
+ * or work (0: no cap), and stops when converged unless a time or work
+ * was given (a budget given is run out, as before these defaults).
  * Options given keep their values; any other run is left as given. */
 void tk_options_complete(tk_options *o, const tk_options_given *given);
 

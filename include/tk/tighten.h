@@ -168,11 +168,13 @@ typedef struct tk_options {
 #define TK_RUN_MAX_VERTICES 1000000
 
 /* The defaults that tighten (tk_options_complete): a run given no stop
- * criterion but the time goes coarse to fine at TK_DEFAULT_RESOLUTION
- * (unless it was given a vertex count) and autoscales; given no time, it
- * stops when converged or after TK_DEFAULT_SECONDS. */
+ * criterion but a time or work goes coarse to fine at
+ * TK_DEFAULT_RESOLUTION (unless it was given a vertex count) and
+ * autoscales; given neither time nor work, it stops when converged or
+ * after TK_DEFAULT_WORK of work (max_work: the same run on any machine,
+ * about as many seconds on the reference one). */
 #define TK_DEFAULT_RESOLUTION 5.0
-#define TK_DEFAULT_SECONDS 120.0
+#define TK_DEFAULT_WORK 120.0
 
 /* Why a run stopped. */
 typedef enum tk_stop_reason {

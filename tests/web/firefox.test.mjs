@@ -118,7 +118,7 @@ test('Firefox: a catalogue knot submitted through the form is tightened and show
     await fill('#opt-resolution', 5);
     await fill('#opt-steps', 200);
     await fill('#opt-every', 10);
-    await fill('#opt-time', 0);
+    await fill('#opt-work', 0);
     await fill('#opt-residual', 0);
     await page.click('#submit-button');
     await page.waitForFunction(() => {

@@ -128,7 +128,7 @@ test('a catalogue knot submitted through the form is tightened and shown', async
     assert.ok(options.slice(0, begins).every((n) => n.startsWith('3.1')), options.join(' '));
     assert.equal(await page.inputValue('#catalogue-select'), '3.1');
     await page.selectOption('#catalogue-select', '3.1');
-    await setOptions({ resolution: 5, steps: 300, every: 10, time: 0, residual: 0 });
+    await setOptions({ resolution: 5, steps: 300, every: 10, work: 0, residual: 0 });
     const id = await submitForm();
     shared.trefoil = id;
     await page.waitForSelector('#job-state[data-state="done"]', { timeout: 120000 });
@@ -404,7 +404,7 @@ test('a running job shows live figures and can be cancelled', async () => {
     await page.click('#tab-catalogue');
     await page.fill('#catalogue-filter', '');
     await page.selectOption('#catalogue-select', '8.19');
-    await setOptions({ resolution: 10, steps: 1000000, time: 120, every: 50 });
+    await setOptions({ resolution: 10, steps: 1000000, work: 120, every: 50 });
     const id = await submitForm();
     await page.waitForSelector('#job-state[data-state="running"]', { timeout: 60000 });
     const stepOf = async () => Number(await page.locator('#fig-step').innerText());
