@@ -72,7 +72,7 @@ static int tighten(const char *dir, const char *knot, int index, double seconds,
     if (at) {
         *at = '\0';
         o.resolution = 0.0;
-        o.vertices = (size_t)atol(at + 1);
+        o.vertices = (size_t)strtoul(at + 1, NULL, 10);
     }
     snprintf(path, sizeof path, "%s/%s.vect", dir, name);
     tk_curve *c = NULL;
@@ -168,7 +168,7 @@ int main(int argc, char **argv)
     int nknots = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--seconds") && i + 1 < argc)
-            seconds = atof(argv[++i]);
+            seconds = strtod(argv[++i], NULL);
         else if (!strcmp(argv[i], "-h") || !strcmp(argv[i], "--help")) {
             usage();
             return 0;

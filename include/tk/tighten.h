@@ -144,8 +144,9 @@
       "as many tries again explore the coarsest polygon alone, from the lowest curve found " \
       "there, the first of them the start turned inside out (0: none)")                      \
     X(seed, SEED, 1, 0, 9007199254740991.0, "seed",                                          \
-      "of the escapes' random deformations: the same seed, the same run (below 2^53, so "    \
-      "that every seed is exact as a JSON number)")
+      "of the escapes' random deformations: the same seed, the same run, given a budget of " \
+      "steps or work (one of seconds is shared out by the clock) (below 2^53, so that every " \
+      "seed is exact as a JSON number)")
 
 /* The snapshots (snapshot_every) keep one vertex count: they cannot be
  * combined with re_resolve, and a run with them does not go coarse to
