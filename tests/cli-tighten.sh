@@ -194,7 +194,8 @@ const j = JSON.parse(require("fs").readFileSync(process.argv[1], "utf8")), o = j
 const tight = 8 * Math.PI;
 if (j.stop_reason !== "converged") throw new Error(`stopped: ${j.stop_reason}`);
 if (!(j.ropelength > tight && j.ropelength < tight * 1.001)) throw new Error(`ropelength ${j.ropelength}`);
-if (!(o.resolution === 5 && o.autoscale === true && o.converge === true && o.time === 120 && o.steps === 0))
+if (!(o.resolution === 5 && o.autoscale === true && o.converge === true && o.work === 120 && o.time === 0 &&
+      o.steps === 0))
     throw new Error(`options ${JSON.stringify(o)}`);
 ' "$tmp/default.json"
 check $? "no options: converged at the tight Hopf link ($(head -c 300 "$tmp/default.json"))"

@@ -198,8 +198,6 @@ const char *tk_stop_reason_name(tk_stop_reason r);
 #define TK_STEP_FIELDS(X)                                                                    \
     X(step, LONG, 0, 0, 0, "step", "1 for the first step; 0 for the start")                 \
     X(seconds, REAL, 0, 0, 0, "seconds", "wall time since the run started")                 \
-    X(work, REAL, 0, 0, 0, "work",                                                          \
-      "work done since the run started, in seconds of a reference processor (tk_run_work)")  \
     X(ropelength, REAL, 0, 0, 0, "ropelength", "2 length / thickness (Definition 1)")       \
     X(length, REAL, 0, 0, 0, "length", "of the curve")                                      \
     X(thickness, REAL, 0, 0, 0, "thickness", "the tube diameter (Definition 1)")            \
@@ -220,7 +218,10 @@ const char *tk_stop_reason_name(tk_stop_reason r);
     X(escapes, INT, 0, 0, 0, "escapes", "escapes tried so far (tk_run_escapes)")            \
     X(restarts, INT, 0, 0, 0, "restarts",                                                   \
       "times the curve was replaced by another: an escape's deformation of the best, or "   \
-      "the best put back (the figures jump where it changes)")
+      "the best put back (the figures jump where it changes)")                              \
+    X(work, REAL, 0, 0, 0, "work",                                                          \
+      "work done since the run started, in seconds of a reference processor (tk_run_work; " \
+      "last, so that the columns before it keep their places)")
 
 typedef struct tk_step_report {
     TK_STEP_FIELDS(TK_FIELD_DECLARE)

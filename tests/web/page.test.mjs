@@ -110,7 +110,8 @@ test('the form\'s defaults tighten: the Hopf link ends converged at 8 pi', async
     assert.equal(job.state, 'done', JSON.stringify(job));
     assert.equal(job.stop_reason, 'converged');
     const o = job.options;
-    assert.ok(o.resolution === 5 && o.autoscale === true && o.converge === true && o.time === 120 && o.steps === 0,
+    assert.ok(o.resolution === 5 && o.autoscale === true && o.converge === true && o.work === 120 && o.time === 0 &&
+        o.steps === 0,
         JSON.stringify(o));
     assert.ok(job.ropelength > 8 * Math.PI && job.ropelength < 8 * Math.PI * 1.001, `ropelength ${job.ropelength}`);
     await page.fill('#catalogue-filter', '');
