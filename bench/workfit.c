@@ -89,15 +89,16 @@ static int tighten(const char *dir, const char *knot, int index, double seconds,
     double before[NCOUNTS], after[NCOUNTS];
     counts_of(&t.work, before);
     tk_step_report last = *tk_run_latest(run);
-    long taken = 0;
+    long taken = 0; /* steps in the stretch under way */
     int rc = TK_OK;
     while (rc == TK_OK && tk_run_stop_reason(run) == TK_STOP_NONE && *n < MOST_ROWS) {
         rc = tk_run_step(run, &err);
         const tk_step_report *s = tk_run_latest(run);
         bool stopped = rc != TK_OK || tk_run_stop_reason(run) != TK_STOP_NONE;
         /* a stretch ends every STRETCH steps and where the polygon changes */
-        if (++taken % STRETCH && !stopped && s->vertices == last.vertices)
+        if (++taken < STRETCH && !stopped && s->vertices == last.vertices)
             continue;
+        taken = 0;
         tk_run_timing_get(run, &t);
         counts_of(&t.work, after);
         row *r = &rows[(*n)++];
